@@ -1,0 +1,1 @@
+"""Benchmarks: measured speed and memory, printed as tables (never asserted in tests)."""

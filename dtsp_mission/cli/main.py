@@ -1,0 +1,71 @@
+"""The ``dtsp-mission`` command group.
+
+Every command, built-in or third-party, is registered in the ``dtsp_mission.commands``
+entry-point group and loaded through it, so the plugin path runs on every start.  A command
+that fails to load is listed as broken (with the reason, under ``-v``) and the rest still work.
+"""
+
+from __future__ import annotations
+
+import logging
+from importlib.metadata import entry_points
+
+import click
+
+from .. import __version__
+
+COMMAND_GROUP = "dtsp_mission.commands"
+log = logging.getLogger("dtsp_mission")
+
+
+def _broken_command(name: str, error: BaseException) -> click.Command:
+    @click.command(name=name, help=f"(broken plugin: {error.__class__.__name__})")
+    def broken() -> None:
+        raise click.ClickException(f"the '{name}' command could not be loaded: {error!r}")
+    return broken
+
+
+class PluginGroup(click.Group):
+    """A click group whose commands come from an entry-point group, loaded on first use."""
+
+    def __init__(self, *args, entry_point_group: str, **kwargs) -> None:
+        super().__init__(*args, **kwargs)
+        self._entry_point_group = entry_point_group
+        self._loaded = False
+
+    def _load(self) -> None:
+        if self._loaded:
+            return
+        self._loaded = True
+        for entry_point in sorted(entry_points(group=self._entry_point_group), key=lambda e: e.name):
+            if entry_point.name in self.commands:
+                continue
+            try:
+                command = entry_point.load()
+                if not isinstance(command, click.Command):
+                    raise TypeError(f"{entry_point.value} is not a click command")
+            except Exception as error:  # a broken plugin must not break the CLI
+                log.warning("command plugin %r is broken: %r", entry_point.name, error)
+                command = _broken_command(entry_point.name, error)
+            self.add_command(command, entry_point.name)
+
+    def list_commands(self, ctx: click.Context) -> list[str]:
+        self._load()
+        return super().list_commands(ctx)
+
+    def get_command(self, ctx: click.Context, name: str) -> click.Command | None:
+        self._load()
+        return super().get_command(ctx, name)
+
+
+@click.group(cls=PluginGroup, entry_point_group=COMMAND_GROUP,
+             context_settings={"help_option_names": ["-h", "--help"]})
+@click.version_option(__version__, prog_name="dtsp-mission")
+@click.option("-v", "--verbose", count=True, help="More log output (repeatable).")
+@click.option("-q", "--quiet", is_flag=True, help="Only errors.")
+def cli(verbose: int, quiet: bool) -> None:
+    """Plan Dubins tours through many targets for fixed-wing UAVs and turn them into MAVLink
+    missions."""
+    level = logging.ERROR if quiet else (logging.DEBUG if verbose > 1 else
+                                         logging.INFO if verbose else logging.WARNING)
+    logging.basicConfig(level=level, format="%(levelname)s %(name)s: %(message)s")

@@ -1,0 +1,29 @@
+"""The errors dtsp-mission raises.
+
+Every error derives from :class:`DtspError`; each subclass also derives from the built-in
+exception a caller would naturally catch (``ValueError``, ``OSError``), so library users need
+not know this module.  The CLI turns any :class:`DtspError` into a one-line message and exit
+code 2; nothing else is caught there.
+"""
+
+from __future__ import annotations
+
+
+class DtspError(Exception):
+    """Root of every error raised deliberately by dtsp-mission."""
+
+
+class InputError(DtspError, ValueError):
+    """The user's input (targets, radius, options) cannot be planned as given."""
+
+
+class FileFormatError(DtspError, ValueError):
+    """A file could be read but its content is not what its format requires."""
+
+
+class FileAccessError(DtspError, OSError):
+    """A file could not be read or written."""
+
+
+class TourInvalidError(DtspError, ValueError):
+    """A tour failed the geometric checker; the message lists what failed."""

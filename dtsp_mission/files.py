@@ -1,0 +1,61 @@
+"""Reading and writing files with clear errors; every write is atomic.
+
+An output file is either written completely or not touched at all: content goes to a temporary
+file in the same directory, is flushed to disk, and replaces the target in one rename.
+"""
+
+from __future__ import annotations
+
+import os
+import tempfile
+from pathlib import Path
+
+from .errors import FileAccessError
+
+
+def read_text(path: str | os.PathLike) -> str:
+    """The file's text (UTF-8, BOM accepted), or :class:`FileAccessError` saying why not."""
+    path = Path(path)
+    try:
+        return path.read_text(encoding="utf-8-sig")
+    except FileNotFoundError:
+        raise FileAccessError(f"{path}: no such file") from None
+    except IsADirectoryError:
+        raise FileAccessError(f"{path}: is a directory, not a file") from None
+    except PermissionError:
+        raise FileAccessError(f"{path}: permission denied") from None
+    except UnicodeDecodeError as error:
+        raise FileAccessError(f"{path}: not a UTF-8 text file ({error.reason} at byte "
+                              f"{error.start})") from None
+    except OSError as error:
+        raise FileAccessError(f"{path}: cannot be read ({error.strerror})") from None
+
+
+def write_atomic(path: str | os.PathLike, content: str | bytes) -> Path:
+    """Write ``content`` to ``path`` so that readers see the old file or the whole new one."""
+    path = Path(path)
+    data = content.encode("utf-8") if isinstance(content, str) else content
+    directory = path.parent if str(path.parent) else Path(".")
+    if not directory.is_dir():
+        raise FileAccessError(f"{path}: directory {directory} does not exist")
+    try:
+        handle, temporary = tempfile.mkstemp(prefix=f".{path.name}.", suffix=".part",
+                                             dir=directory)
+    except OSError as error:
+        raise FileAccessError(f"{path}: cannot write in {directory} ({error.strerror})") from None
+    try:
+        with os.fdopen(handle, "wb") as stream:
+            stream.write(data)
+            stream.flush()
+            os.fsync(stream.fileno())
+        os.chmod(temporary, 0o644)
+        os.replace(temporary, path)
+    except BaseException as error:
+        try:
+            os.unlink(temporary)
+        except OSError:
+            pass
+        if isinstance(error, OSError):
+            raise FileAccessError(f"{path}: cannot be written ({error.strerror})") from None
+        raise
+    return path

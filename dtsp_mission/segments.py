@@ -1,0 +1,129 @@
+"""Exact planar path segments: straight lines and circular arcs, and where they lead.
+
+Conventions used throughout the metric core: positions in metres in a local frame whose x axis
+points east and y axis north; a heading is the direction of travel in radians, counter-clockwise
+from +x.  A segment is its start pose, its length and its signed curvature (``+1/R`` for a left
+turn of radius ``R``, ``-1/R`` for a right turn, ``0`` for a line).  A chain of segments is
+stored as arrays (structure of arrays), so tours with 10^5 targets stay cheap.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import numpy as np
+
+TWO_PI = 2.0 * np.pi
+
+
+def wrap_angle(angle_rad: np.ndarray | float) -> np.ndarray | float:
+    """Return the angle(s) folded into ``(-pi, pi]``."""
+    wrapped = np.mod(np.asarray(angle_rad) + np.pi, TWO_PI) - np.pi
+    wrapped = np.where(wrapped <= -np.pi, wrapped + TWO_PI, wrapped)
+    return wrapped if np.ndim(wrapped) else float(wrapped)
+
+
+def advance(poses: np.ndarray, length_m: np.ndarray | float,
+            curvature_1_m: np.ndarray | float) -> np.ndarray:
+    """Pose reached after ``length_m`` along a segment of constant curvature from ``poses``.
+
+    ``poses`` has shape ``(..., 3)`` (x_m, y_m, heading_rad); the other arguments broadcast
+    against ``poses[..., 0]``.  Exact for lines and arcs alike (chord form, no small-angle
+    branch), so it is continuous as the curvature goes to zero.
+    """
+    poses = np.asarray(poses, dtype=float)
+    length_m = np.asarray(length_m, dtype=float)
+    curvature_1_m = np.asarray(curvature_1_m, dtype=float)
+    x, y, heading = poses[..., 0], poses[..., 1], poses[..., 2]
+    half_turn = 0.5 * curvature_1_m * length_m
+    chord = length_m * np.sinc(half_turn / np.pi)  # np.sinc(u) = sin(pi u) / (pi u)
+    direction = heading + half_turn
+    out = np.empty(np.broadcast(x, length_m, curvature_1_m).shape + (3,))
+    out[..., 0] = x + chord * np.cos(direction)
+    out[..., 1] = y + chord * np.sin(direction)
+    out[..., 2] = heading + 2.0 * half_turn
+    return out
+
+
+@dataclass(frozen=True)
+class SegmentChain:
+    """A sequence of exact segments, each given by its start pose, length and curvature.
+
+    Consecutive segments are meant to join (end pose of one = start pose of the next), but the
+    chain itself does not enforce it: the tour checker measures it.
+    """
+
+    starts: np.ndarray          # (m, 3) x_m, y_m, heading_rad at each segment start
+    lengths_m: np.ndarray       # (m,) >= 0
+    curvatures_1_m: np.ndarray  # (m,) signed curvature
+
+    def __post_init__(self) -> None:
+        starts = np.ascontiguousarray(self.starts, dtype=float).reshape(-1, 3)
+        lengths = np.ascontiguousarray(self.lengths_m, dtype=float).reshape(-1)
+        curvatures = np.ascontiguousarray(self.curvatures_1_m, dtype=float).reshape(-1)
+        if not (len(starts) == len(lengths) == len(curvatures)):
+            raise ValueError("starts, lengths_m and curvatures_1_m must have the same length")
+        object.__setattr__(self, "starts", starts)
+        object.__setattr__(self, "lengths_m", lengths)
+        object.__setattr__(self, "curvatures_1_m", curvatures)
+
+    @classmethod
+    def empty(cls) -> "SegmentChain":
+        return cls(np.zeros((0, 3)), np.zeros(0), np.zeros(0))
+
+    @classmethod
+    def concatenate(cls, chains: list["SegmentChain"]) -> "SegmentChain":
+        """The chains one after another, in order."""
+        if not chains:
+            return cls.empty()
+        return cls(np.concatenate([c.starts for c in chains]),
+                   np.concatenate([c.lengths_m for c in chains]),
+                   np.concatenate([c.curvatures_1_m for c in chains]))
+
+    def __len__(self) -> int:
+        return len(self.lengths_m)
+
+    @property
+    def length_m(self) -> float:
+        """Total length of the chain."""
+        return float(np.sum(self.lengths_m))
+
+    @property
+    def offsets_m(self) -> np.ndarray:
+        """Arc length at the start of each segment, plus the total at the end: shape (m+1,)."""
+        return np.concatenate(([0.0], np.cumsum(self.lengths_m)))
+
+    def ends(self) -> np.ndarray:
+        """End pose of every segment, shape (m, 3); headings are not wrapped."""
+        return advance(self.starts, self.lengths_m, self.curvatures_1_m)
+
+    def without_empty(self, min_length_m: float) -> "SegmentChain":
+        """The chain with segments shorter than ``min_length_m`` removed."""
+        keep = self.lengths_m >= min_length_m
+        return SegmentChain(self.starts[keep], self.lengths_m[keep], self.curvatures_1_m[keep])
+
+    def locate(self, s_m: np.ndarray | float) -> tuple[np.ndarray, np.ndarray]:
+        """Segment index and offset within it for arc length(s) ``s_m`` in ``[0, length]``."""
+        s_m = np.asarray(s_m, dtype=float)
+        offsets = self.offsets_m
+        index = np.searchsorted(offsets, s_m, side="right") - 1
+        index = np.clip(index, 0, len(self) - 1)
+        return index, s_m - offsets[index]
+
+    def pose_at(self, s_m: np.ndarray | float) -> np.ndarray:
+        """Pose(s) at arc length(s) ``s_m`` from the start of the chain, shape ``s.shape + (3,)``."""
+        index, within = self.locate(s_m)
+        return advance(self.starts[index], within, self.curvatures_1_m[index])
+
+    def sample(self, max_step_m: float) -> np.ndarray:
+        """Poses along the whole chain, at most ``max_step_m`` apart, including every segment
+        start and the final end pose, shape (k, 3)."""
+        if len(self) == 0:
+            return np.zeros((0, 3))
+        pieces = np.maximum(1, np.ceil(self.lengths_m / max_step_m).astype(np.int64))
+        segment = np.repeat(np.arange(len(self)), pieces)
+        first = np.cumsum(pieces) - pieces
+        fraction = (np.arange(len(segment)) - first[segment]) / pieces[segment]
+        poses = advance(self.starts[segment], fraction * self.lengths_m[segment],
+                        self.curvatures_1_m[segment])
+        return np.vstack([poses, self.ends()[-1:]])

@@ -1,0 +1,64 @@
+"""The command line, run as a user runs it (a real process through the console script)."""
+
+import json
+import subprocess
+import sys
+import textwrap
+
+import numpy as np
+import pytest
+
+from dtsp_mission.tour import tour_through_poses, tour_to_dict, write_tour
+
+
+def run(*arguments, env=None):
+    return subprocess.run([sys.executable, "-m", "dtsp_mission.cli", *arguments],
+                          capture_output=True, text=True, env=env, timeout=300)
+
+
+def test_dubins_command_prints_the_exact_path():
+    result = run("dubins", "0,0,0", "0,0,180", "--radius", "80")
+    assert result.returncode == 0, result.stderr
+    assert "word RLR" in result.stdout and "(7.330383 rho)" in result.stdout
+
+
+def test_dubins_command_rejects_bad_radius_with_exit_2():
+    result = run("dubins", "0,0,0", "10,0,0", "--radius", "0")
+    assert result.returncode == 2
+    assert "turn radius must be a positive number" in result.stderr
+
+
+def test_check_command_on_valid_and_broken_tours(tmp_path, rng):
+    tour = tour_through_poses(rng.uniform(0, 1000, (10, 2)), np.arange(10), np.zeros(10), 50.0)
+    good = write_tour(tour, tmp_path / "good.json")
+    result = run("check", str(good))
+    assert result.returncode == 0 and result.stdout.startswith("valid")
+    data = tour_to_dict(tour)
+    data["segments"][2]["x_m"] += 1.0
+    bad = tmp_path / "bad.json"
+    bad.write_text(json.dumps(data))
+    result = run("check", str(bad))
+    assert result.returncode == 1 and "INVALID" in result.stdout and "C1" in result.stdout
+    result = run("check", str(tmp_path / "missing.json"))
+    assert result.returncode == 2 and "no such file" in result.stderr
+
+
+def test_a_broken_plugin_is_reported_and_the_cli_still_works(tmp_path):
+    """A distribution on the path whose command entry point cannot be imported."""
+    dist = tmp_path / "broken_plugin-1.0.dist-info"
+    dist.mkdir()
+    (dist / "METADATA").write_text("Metadata-Version: 2.1\nName: broken-plugin\nVersion: 1.0\n")
+    (dist / "entry_points.txt").write_text(textwrap.dedent("""\
+        [dtsp_mission.commands]
+        exploding = no_such_module_anywhere:command
+        """))
+    import os
+    env = dict(os.environ, PYTHONPATH=str(tmp_path) + os.pathsep + os.environ.get("PYTHONPATH", ""))
+    listing = run("--help", env=env)
+    assert listing.returncode == 0
+    assert "exploding" in listing.stdout and "broken plugin" in listing.stdout
+    assert "dubins" in listing.stdout
+    works = run("dubins", "0,0,0", "100,0,0", "--radius", "10", env=env)
+    assert works.returncode == 0 and "word LSL" in works.stdout
+    broken = run("exploding", env=env)
+    assert broken.returncode != 0 and "could not be loaded" in broken.stderr
