@@ -127,3 +127,30 @@ class SegmentChain:
         poses = advance(self.starts[segment], fraction * self.lengths_m[segment],
                         self.curvatures_1_m[segment])
         return np.vstack([poses, self.ends()[-1:]])
+
+    def project(self, index: np.ndarray, points_m: np.ndarray) -> np.ndarray:
+        """Arc length within segment ``index[i]`` of the point of that segment nearest to
+        ``points_m[i]`` (exact for lines; for arcs, by the angle about the centre)."""
+        index = np.asarray(index)
+        points = np.asarray(points_m, dtype=float).reshape(-1, 2)
+        starts = self.starts[index]
+        lengths = self.lengths_m[index]
+        curvature = self.curvatures_1_m[index]
+        heading = starts[:, 2]
+        direction = np.column_stack([np.cos(heading), np.sin(heading)])
+        offset = points - starts[:, :2]
+        along_line = np.einsum("ij,ij->i", offset, direction)
+        turning = curvature != 0
+        radius = np.where(turning, 1.0 / np.where(turning, curvature, 1.0), 0.0)   # signed
+        centre = starts[:, :2] + radius[:, None] * np.column_stack([-direction[:, 1], direction[:, 0]])
+        from_centre = starts[:, :2] - centre
+        to_point = points - centre
+        angle = np.arctan2(from_centre[:, 0] * to_point[:, 1] - from_centre[:, 1] * to_point[:, 0],
+                           np.einsum("ij,ij->i", from_centre, to_point))
+        swept = np.mod(np.sign(curvature) * angle, 2.0 * np.pi)
+        # Past the end of the arc: the nearer end (start if the gap to a full turn is smaller).
+        beyond = swept * np.abs(radius) > lengths
+        swept = np.where(beyond & (2.0 * np.pi - swept < swept - lengths / np.maximum(np.abs(radius), 1e-300)),
+                         0.0, swept)
+        along_arc = swept * np.abs(radius)
+        return np.clip(np.where(turning, along_arc, along_line), 0.0, lengths)

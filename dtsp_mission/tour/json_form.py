@@ -43,7 +43,7 @@ def tour_to_dict(tour: Tour) -> dict[str, Any]:
         "frame": {"type": "local", "x": "east", "y": "north", "heading": "radians counter-clockwise from east"},
         "rho_m": tour.rho_m,
         "length_m": tour.length_m,
-        "planner": {"name": tour.planner, "parameters": tour.parameters},
+        "planner": {"name": tour.planner, "parameters": tour.parameters, "report": tour.report},
         "targets": [{"x_m": x, "y_m": y} for x, y in tour.targets_m.tolist()],
         "visits": [{"target": int(i), "s_m": float(tour.visit_s_m[i])} for i in order],
         "segments": segments,
@@ -108,7 +108,7 @@ def tour_from_dict(data: Any) -> Tour:
     if not isinstance(planner, dict):
         raise FileFormatError("tour: 'planner' must be an object")
     return Tour(chain, rho, targets, visit_s, str(planner.get("name", "")),
-                dict(planner.get("parameters") or {}))
+                dict(planner.get("parameters") or {}), dict(planner.get("report") or {}))
 
 
 def _records(items: list, name: str) -> list[dict]:

@@ -14,7 +14,7 @@ import numpy as np
 
 from ..dubins import chain_of_paths, shortest_words
 from ..errors import InputError
-from ..segments import SegmentChain
+from ..segments import SegmentChain, advance
 
 #: Segments shorter than this fraction of the turn radius are dropped when chaining paths.
 EMPTY_SEGMENT_RHO = 1e-12
@@ -34,6 +34,7 @@ class Tour:
     visit_s_m: np.ndarray             # (n,)
     planner: str = ""
     parameters: dict[str, Any] = field(default_factory=dict)
+    report: dict[str, Any] = field(default_factory=dict)   # what the planner measured
 
     def __post_init__(self) -> None:
         object.__setattr__(self, "targets_m", np.asarray(self.targets_m, dtype=float).reshape(-1, 2))
@@ -53,6 +54,31 @@ class Tour:
     def visit_poses(self) -> np.ndarray:
         """Pose of the vehicle at each target's visit, row ``i`` for target ``i``, shape (n, 3)."""
         return self.chain.pose_at(self.visit_s_m)
+
+
+def snap_visits(chain: SegmentChain, targets_m: np.ndarray, approximate_s_m: np.ndarray) -> np.ndarray:
+    """Arc lengths of the targets on ``chain``, consistent with the chain's own cumulative sum.
+
+    Planners know roughly where each target lies (their own running sums, which drift from the
+    chain's by rounding over millions of segments); this finds the exact point: the target is
+    projected onto the segment its approximate arc length falls in and onto both neighbours,
+    and the nearest wins.  Result: ``offsets_m[k] + offset within segment k``.
+    """
+    targets = np.asarray(targets_m, dtype=float).reshape(-1, 2)
+    offsets = chain.offsets_m
+    last = len(chain) - 1
+    guess = np.clip(np.searchsorted(offsets, approximate_s_m, side="right") - 1, 0, last)
+    best_s = np.asarray(approximate_s_m, dtype=float).copy()
+    best_miss = np.full(len(targets), np.inf)
+    for shift in (0, -1, 1, -2, 2):
+        index = np.clip(guess + shift, 0, last)
+        within = chain.project(index, targets)
+        pose = advance(chain.starts[index], within, chain.curvatures_1_m[index])
+        miss = np.hypot(*(pose[:, :2] - targets).T)
+        better = miss < best_miss
+        best_s = np.where(better, offsets[index] + within, best_s)
+        best_miss = np.where(better, miss, best_miss)
+    return best_s
 
 
 def tour_through_poses(targets_m: np.ndarray, order: np.ndarray, headings_rad: np.ndarray,
@@ -84,4 +110,5 @@ def tour_through_poses(targets_m: np.ndarray, order: np.ndarray, headings_rad: n
         chain = SegmentChain(poses[:1], np.array([2.0 * np.pi * rho_m]), np.array([1.0 / rho_m]))
     visit_s = np.empty(len(order))
     visit_s[order] = leg_start_s
+    visit_s = snap_visits(chain, targets_m, visit_s)
     return Tour(chain, float(rho_m), targets_m, visit_s, planner, dict(parameters or {}))

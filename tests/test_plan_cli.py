@@ -1,0 +1,83 @@
+"""``dtsp-mission plan`` end to end on local-metre CSV files, and its bad-input errors."""
+
+import subprocess
+import sys
+from pathlib import Path
+
+import numpy as np
+import pytest
+
+from conftest import assert_valid_tour
+from dtsp_mission.tour import read_tour
+
+EXAMPLE = Path(__file__).parents[1] / "examples" / "site-local.csv"
+
+
+def run(*arguments):
+    return subprocess.run([sys.executable, "-m", "dtsp_mission.cli", "plan", *arguments],
+                          capture_output=True, text=True, timeout=300)
+
+
+@pytest.mark.parametrize("algorithm", ["auto", "rbta", "alternating"])
+def test_plan_the_bundled_example(tmp_path, algorithm):
+    out = tmp_path / "tour.json"
+    result = run(str(EXAMPLE), "--radius", "80", "--algorithm", algorithm, "-o", str(out))
+    assert result.returncode == 0, result.stderr
+    assert "420 targets" in result.stdout and "lower bound" in result.stdout
+    tour = read_tour(out)
+    assert_valid_tour(tour)
+    assert len(tour.targets_m) == 420
+    assert tour.planner.startswith(algorithm)
+
+
+def test_auto_is_never_longer_than_its_candidates(tmp_path):
+    result = run(str(EXAMPLE), "--radius", "80")
+    lengths = [float(line.split(":")[1].split("m")[0].replace(",", ""))
+               for line in result.stdout.splitlines() if "candidate" in line]
+    chosen = float(result.stdout.split("tour ")[1].split(" m")[0].replace(",", ""))
+    assert len(lengths) == 2 and chosen == min(lengths)
+
+
+def test_rbta_falls_back_when_too_few_targets(tmp_path):
+    targets = tmp_path / "few.csv"
+    targets.write_text("x,y\n0,0\n5000,0\n0,5000\n5000,5000\n2500,2500\n")
+    result = run(str(targets), "--radius", "100", "--algorithm", "rbta", "-o", str(tmp_path / "t.json"))
+    assert result.returncode == 0 and "Alternating Algorithm instead" in result.stderr
+    assert read_tour(tmp_path / "t.json").planner == "alternating"
+    result = run(str(targets), "--radius", "100", "--algorithm", "rbta", "--no-fallback",
+                 "-o", str(tmp_path / "u.json"))
+    assert result.returncode == 2 and "needs at least" in result.stderr
+    assert not (tmp_path / "u.json").exists()
+
+
+@pytest.mark.parametrize("content, message", [
+    ("", "the file is empty"),
+    ("x,y\n", "no targets below the header"),
+    ("lat,lon\n1,2\n", "must name columns 'x' and 'y'"),
+    ("x,y\n1,2\n3,abc\n", "line 3: x and y must be numbers"),
+    ("x,y\n1,2\nnan,4\n", "line 3: x and y must be finite"),
+])
+def test_bad_target_files_give_a_clear_message_exit_2_and_no_output(tmp_path, content, message):
+    targets = tmp_path / "targets.csv"
+    targets.write_text(content)
+    out = tmp_path / "tour.json"
+    result = run(str(targets), "--radius", "80", "-o", str(out))
+    assert result.returncode == 2
+    assert message in result.stderr
+    assert not out.exists()
+
+
+def test_bad_radius_and_missing_file(tmp_path):
+    result = run(str(EXAMPLE), "--radius", "-5")
+    assert result.returncode == 2 and "turn radius must be a positive number" in result.stderr
+    result = run(str(tmp_path / "nope.csv"), "--radius", "80")
+    assert result.returncode == 2 and "no such file" in result.stderr
+
+
+def test_duplicates_are_merged_and_reported(tmp_path):
+    targets = tmp_path / "dup.csv"
+    rows = "\n".join(f"{x:.1f},{y:.1f}" for x, y in np.random.default_rng(1).uniform(0, 800, (30, 2)))
+    targets.write_text("x,y\n" + rows + "\n" + rows.splitlines()[0] + "\n")
+    result = run(str(targets), "--radius", "50", "-o", str(tmp_path / "t.json"))
+    assert result.returncode == 0 and "1 duplicate targets merged" in result.stderr
+    assert len(read_tour(tmp_path / "t.json").targets_m) == 30
