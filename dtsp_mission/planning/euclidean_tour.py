@@ -10,11 +10,14 @@ benchmarks).  The result is deterministic: no randomness is used.
 
 from __future__ import annotations
 
+import logging
+
 import numba
 import numpy as np
 from scipy.spatial import cKDTree
 
 _JIT = dict(cache=True, error_model="numpy")
+log = logging.getLogger(__name__)
 
 
 def hilbert_order(points_m: np.ndarray, bits: int = 16) -> np.ndarray:
@@ -87,7 +90,8 @@ def _improve(points, tour, neighbours):
     head = 0
     count = n
     eps = 1e-10
-    budget = 100 * n + 1000      # improving moves; a guarantee of termination, never reached
+    budget = 100 * n + 1000      # improving moves: a guarantee of termination (tests check
+                                 # that it is never reached)
     while count > 0 and budget > 0:
         a = queue[head]
         head = (head + 1) % n
@@ -107,7 +111,7 @@ def _improve(points, tour, neighbours):
                 if d_ac >= d_ab:
                     break
                 e = tour[(pos[c] + 1) % n] if direction == 0 else tour[(pos[c] - 1) % n]
-                if c == b or e == a:
+                if c == a or c == b or e == a:
                     continue
                 delta = d_ac + _d(points, b, e) - d_ab - _d(points, c, e)
                 if delta < -eps:
@@ -161,7 +165,18 @@ def _improve(points, tour, neighbours):
                 queued[city] = True
                 queue[(head + count) % n] = city
                 count += 1
-    return tour
+    return tour, budget
+
+
+def neighbour_lists(points_m: np.ndarray, k: int) -> np.ndarray:
+    """The k nearest other points of every point, (n, k).  A point is removed from its own
+    list explicitly: among duplicates the KD-tree need not list it first."""
+    n = len(points_m)
+    _, found = cKDTree(points_m).query(points_m, k=k + 1)
+    not_self = found != np.arange(n)[:, None]
+    first_others = np.argsort(~not_self, axis=1, kind="stable")
+    return np.ascontiguousarray(np.take_along_axis(found, first_others, axis=1)[:, :k],
+                                dtype=np.int64)
 
 
 def tour_length(points_m: np.ndarray, order: np.ndarray) -> float:
@@ -178,6 +193,17 @@ def euclidean_tour(points_m: np.ndarray, neighbour_count: int = 10) -> np.ndarra
         return np.arange(n)
     order = hilbert_order(points)
     k = min(neighbour_count, n - 1)
-    _, neighbours = cKDTree(points).query(points, k=k + 1)
-    neighbours = np.ascontiguousarray(neighbours[:, 1:], dtype=np.int64)
-    return _improve(points, order.astype(np.int64), neighbours)
+    neighbours = neighbour_lists(points, k)
+    tour, moves_left = _improve(points, order.astype(np.int64), neighbours)
+    if moves_left <= 0:
+        log.warning("Euclidean tour: improvement stopped by its move budget (%d points)", n)
+    return tour
+
+
+def improvement_moves_left(points_m: np.ndarray, neighbour_count: int = 10) -> int:
+    """How much of the improver's move budget is left after improving a Hilbert tour: a
+    positive number means it stopped because no improving move remained (tests use this)."""
+    points = np.ascontiguousarray(points_m, dtype=float).reshape(-1, 2)
+    n = len(points)
+    neighbours = neighbour_lists(points, min(neighbour_count, n - 1))
+    return int(_improve(points, hilbert_order(points).astype(np.int64), neighbours)[1])

@@ -11,7 +11,8 @@ from conftest import assert_valid_tour
 from dtsp_mission.errors import InputError
 from dtsp_mission.planning import TilingUnavailable, get_planner, planners
 from dtsp_mission.planning.alternating import alternating_headings
-from dtsp_mission.planning.euclidean_tour import euclidean_tour, hilbert_order, tour_length
+from dtsp_mission.planning.euclidean_tour import (euclidean_tour, hilbert_order,
+                                                 improvement_moves_left, tour_length)
 from dtsp_mission.planning.lower_bounds import (lower_bound, one_tree_lower_bound,
                                                 stochastic_lower_bound)
 from dtsp_mission.planning.region import bounding_region, minimum_area_region
@@ -68,10 +69,13 @@ def test_rbta_says_when_it_cannot_tile():
 
 def test_lemma_2_2_leftovers_are_few():
     """Lemma 2.2: O(log n) leftovers w.h.p.; the proof's bound is 24 log2 n."""
+    n = 5000
+    i_star = math.floor(math.log2(n) - math.log2(math.log2(n)) - math.log2(6))
     for seed in range(5):
-        n = 5000
         tour = get_planner("rbta").plan(uniform(n, 100 + seed), 100.0)
-        assert tour.report["leftovers"] < 24 * math.log2(n)
+        after_i_star = n - sum(p["serviced"] for p in tour.report["phases"][:i_star])
+        assert after_i_star < 24 * math.log2(n)
+        assert tour.report["leftovers"] <= after_i_star
 
 
 @settings(max_examples=25)
@@ -140,3 +144,13 @@ def test_regions_contain_the_targets():
         local = region.to_local(targets)
         assert (local >= -1e-6).all() and (local <= [region.width_m + 1e-6, region.height_m + 1e-6]).all()
     assert minimum_area_region(targets).area_m2 <= bounding_region(targets).area_m2 + 1e-6
+
+
+@pytest.mark.parametrize("n, duplicates, seed", [(60, 20, 0), (50, 49, 3), (400, 133, 5), (2000, 0, 1)])
+def test_euclidean_improvement_ends_by_itself_even_with_duplicates(n, duplicates, seed):
+    """Regression: a point listed as its own neighbour made 2-opt cycle forever."""
+    points = uniform(n, seed)
+    points[:duplicates] = points[0]
+    assert improvement_moves_left(points) > 0
+    order = euclidean_tour(points)
+    assert np.array_equal(np.sort(order), np.arange(n))
