@@ -11,8 +11,8 @@ from conftest import assert_valid_tour
 from dtsp_mission.errors import InputError
 from dtsp_mission.planning import TilingUnavailable, get_planner, planners
 from dtsp_mission.planning.alternating import alternating_headings
-from dtsp_mission.planning.euclidean_tour import (euclidean_tour, hilbert_order,
-                                                 improvement_moves_left, tour_length)
+from dtsp_mission.planning.euclidean_tour import (euclidean_tour, improvement_moves_left,
+                                                 tour_length)
 from dtsp_mission.planning.lower_bounds import (lower_bound, one_tree_lower_bound,
                                                 stochastic_lower_bound)
 from dtsp_mission.planning.region import bounding_region, minimum_area_region
@@ -119,8 +119,7 @@ def test_euclidean_tour_is_a_good_permutation():
     order = euclidean_tour(points)
     assert np.array_equal(np.sort(order), np.arange(3000))
     length = tour_length(points, order)
-    assert length < 0.80 * tour_length(points, hilbert_order(points))
-    assert length < 1.2 * 0.7124 * math.sqrt(3000)        # within 20 % of the BHH constant
+    assert length < 1.08 * 0.7124 * math.sqrt(3000)       # measured 1.05-1.07 at this n
     assert length >= one_tree_lower_bound(points)
 
 
