@@ -3,8 +3,8 @@
 ``shortest_length(starts, goals, rho_m)`` is the hot entry point of every planner.
 """
 
-from .path import (WORDS, DubinsPath, chain_of_paths, shortest_length, shortest_path,
-                   shortest_words)
+from .path import (WORDS, DubinsPath, chain_of_paths, check_radius, shortest_length,
+                   shortest_path, shortest_words)
 
-__all__ = ["WORDS", "DubinsPath", "chain_of_paths", "shortest_length", "shortest_path",
+__all__ = ["WORDS", "DubinsPath", "chain_of_paths", "check_radius", "shortest_length", "shortest_path",
            "shortest_words"]

@@ -20,7 +20,8 @@ from .trig import REDUCTION_LIMIT
 WORDS = kernel.WORDS
 
 
-def _check_radius(rho_m: float) -> float:
+def check_radius(rho_m: float) -> float:
+    """The turn radius as a float, or :class:`InputError` unless it is a positive number."""
     rho = float(rho_m)
     if not np.isfinite(rho) or rho <= 0.0:
         raise InputError(f"turn radius must be a positive number of metres, got {rho_m!r}")
@@ -56,7 +57,7 @@ def shortest_length(starts: np.ndarray, goals: np.ndarray, rho_m: float) -> np.n
     against each other; the result has the broadcast shape without the last axis.  Exact up to
     floating-point rounding (compared with OMPL to 1e-9 relative in the tests).
     """
-    rho = _check_radius(rho_m)
+    rho = check_radius(rho_m)
     columns, shape = _pose_columns(starts, goals)
     out = np.empty(columns[0].shape[0])
     kernel.batch_lengths(*columns, rho, out)
@@ -67,7 +68,7 @@ def shortest_words(starts: np.ndarray, goals: np.ndarray,
                    rho_m: float) -> tuple[np.ndarray, np.ndarray]:
     """Word codes (indices into :data:`WORDS`) and segment lengths (metres, last axis of 3) of
     the shortest paths, for broadcast arrays of poses as in :func:`shortest_length`."""
-    rho = _check_radius(rho_m)
+    rho = check_radius(rho_m)
     columns, shape = _pose_columns(starts, goals)
     count = columns[0].shape[0]
     words = np.empty(count, dtype=np.int8)

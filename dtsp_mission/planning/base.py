@@ -13,6 +13,7 @@ from typing import Any, ClassVar
 
 import numpy as np
 
+from ..dubins import check_radius
 from ..errors import InputError
 from ..tour import Tour, check_tour
 from .region import Region
@@ -33,13 +34,6 @@ def validate_targets(targets_m: np.ndarray) -> np.ndarray:
     return targets
 
 
-def validate_radius(rho_m: float) -> float:
-    rho = float(rho_m)
-    if not np.isfinite(rho) or rho <= 0:
-        raise InputError(f"turn radius must be a positive number of metres, got {rho_m!r}")
-    return rho
-
-
 class Planner:
     """Base class: subclasses set ``name`` and implement :meth:`_plan`."""
 
@@ -54,7 +48,7 @@ class Planner:
         radius ``rho_m``, checked: raises :class:`~dtsp_mission.errors.TourInvalidError` rather
         than return a tour that fails the checker."""
         targets = validate_targets(targets_m)
-        rho = validate_radius(rho_m)
+        rho = check_radius(rho_m)
         tour = self._plan(targets, rho, region)
         check_tour(tour).raise_if_invalid()
         log.info("%s: %d targets, tour %.1f m", self.name, len(targets), tour.length_m)

@@ -95,8 +95,8 @@ def _pieces(local: np.ndarray, phase: int, tiling: BeadTiling, meta_rows: np.nda
     lengths = np.zeros((m, 6))
     curvatures = np.zeros((m, 6))
     s = np.zeros(m)
-    exit_heading = np.where(direction > 0, 0.0, np.pi)
-    exits = np.column_stack([centre_x + direction * half, axis_y, exit_heading])
+    pass_heading = np.where(direction > 0, 0.0, np.pi)
+    exits = np.column_stack([centre_x + direction * half, axis_y, pass_heading])
     if in_bead.any():
         points = np.column_stack([u[in_bead], v[in_bead]])
         radii = bead.radius_through(points, half, rho)
@@ -104,14 +104,14 @@ def _pieces(local: np.ndarray, phase: int, tiling: BeadTiling, meta_rows: np.nda
         sign = direction[in_bead][:, None]
         starts[in_bead, :3, 0] = centre_x[in_bead][:, None] + sign * st[:, :, 0]
         starts[in_bead, :3, 1] = axis_y[in_bead][:, None] + sign * st[:, :, 1]
-        starts[in_bead, :3, 2] = st[:, :, 2] + exit_heading[in_bead][:, None]
+        starts[in_bead, :3, 2] = st[:, :, 2] + pass_heading[in_bead][:, None]
         lengths[in_bead, :3] = le
         curvatures[in_bead, :3] = cu
         starts[in_bead, 3:] = exits[in_bead][:, None, :]
         s[in_bead] = s_in
     general = ~in_bead
     if general.any():
-        entries = np.column_stack([centre_x - direction * half, axis_y, exit_heading])[general]
+        entries = np.column_stack([centre_x - direction * half, axis_y, pass_heading])[general]
         headings = _best_heading(entries, local[general], exits[general], rho)
         poses = np.column_stack([local[general], headings])
         st1, le1, cu1 = _dubins_segments(entries, poses, rho)
