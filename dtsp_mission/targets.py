@@ -26,7 +26,7 @@ class Targets:
     merged_duplicates: int = 0      # how many repeated positions were dropped
 
 
-def _column(header: list[str], choices: tuple[str, ...], path) -> int | None:
+def _column(header: list[str], choices: tuple[str, ...]) -> int | None:
     lowered = [h.strip().lower() for h in header]
     for choice in choices:
         if choice in lowered:
@@ -51,12 +51,12 @@ def read_local_csv(path: str | os.PathLike) -> Targets:
     if not rows:
         raise FileFormatError(f"{path}: the file is empty")
     header = rows[0]
-    x_column = _column(header, ("x", "x_m"), path)
-    y_column = _column(header, ("y", "y_m"), path)
+    x_column = _column(header, ("x", "x_m"))
+    y_column = _column(header, ("y", "y_m"))
     if x_column is None or y_column is None:
         raise FileFormatError(f"{path}: the header must name columns 'x' and 'y' (metres); "
                               f"found {', '.join(h.strip() for h in header)}")
-    name_column = _column(header, ("name",), path)
+    name_column = _column(header, ("name",))
     positions, names = [], []
     for line, row in enumerate(rows[1:], start=2):
         try:

@@ -39,6 +39,13 @@ def alternating_headings(points_m: np.ndarray) -> np.ndarray:
     return headings
 
 
+def alternating_visits(points_m: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """Visiting order (a strong Euclidean tour) and the alternating rule's heading at each
+    visit, in visiting order."""
+    order = euclidean_tour(points_m)
+    return order, alternating_headings(points_m[order])
+
+
 class AlternatingPlanner(Planner):
     """Euclidean tour, odd edges straight, even edges Dubins."""
 
@@ -46,6 +53,5 @@ class AlternatingPlanner(Planner):
     description = "Alternating Algorithm: Euclidean tour, odd edges flown straight, even edges Dubins"
 
     def _plan(self, targets_m: np.ndarray, rho_m: float, region: Region | None) -> Tour:
-        order = euclidean_tour(targets_m, int(self.parameters.get("neighbours", 10)))
-        headings = alternating_headings(targets_m[order])
+        order, headings = alternating_visits(targets_m)
         return tour_through_poses(targets_m, order, headings, rho_m, self.name, self.parameters)

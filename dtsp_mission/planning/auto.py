@@ -2,8 +2,6 @@
 
 from __future__ import annotations
 
-import logging
-
 import numpy as np
 
 from ..tour import Tour
@@ -12,8 +10,6 @@ from .base import Planner
 from .rbta import RBTAPlanner
 from .region import Region
 from .tiling import TilingUnavailable
-
-log = logging.getLogger(__name__)
 
 
 class AutoPlanner(Planner):

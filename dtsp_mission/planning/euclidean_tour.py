@@ -241,16 +241,19 @@ def tour_length(points_m: np.ndarray, order: np.ndarray) -> float:
     return float(np.hypot(*np.diff(closed, axis=0).T).sum())
 
 
+def _construct_and_improve(points: np.ndarray, neighbour_count: int) -> tuple[np.ndarray, int]:
+    """Greedy tour improved to a local optimum, and the move budget left."""
+    neighbours = neighbour_lists(points, min(neighbour_count, len(points) - 1))
+    return _improve(points, _greedy(points, neighbours), neighbours)
+
+
 def euclidean_tour(points_m: np.ndarray, neighbour_count: int = 10) -> np.ndarray:
     """A closed Euclidean tour through all points, as an order of their indices."""
     points = np.ascontiguousarray(points_m, dtype=float).reshape(-1, 2)
     n = len(points)
     if n <= 3:
         return np.arange(n)
-    k = min(neighbour_count, n - 1)
-    neighbours = neighbour_lists(points, k)
-    start = _greedy(points, neighbours)
-    tour, moves_left = _improve(points, start, neighbours)
+    tour, moves_left = _construct_and_improve(points, neighbour_count)
     if moves_left <= 0:
         log.warning("Euclidean tour: improvement stopped by its move budget (%d points)", n)
     return tour
@@ -260,6 +263,4 @@ def improvement_moves_left(points_m: np.ndarray, neighbour_count: int = 10) -> i
     """How much of the improver's move budget is left after improving the greedy tour: a
     positive number means it stopped because no improving move remained (tests use this)."""
     points = np.ascontiguousarray(points_m, dtype=float).reshape(-1, 2)
-    n = len(points)
-    neighbours = neighbour_lists(points, min(neighbour_count, n - 1))
-    return int(_improve(points, _greedy(points, neighbours), neighbours)[1])
+    return int(_construct_and_improve(points, neighbour_count)[1])

@@ -35,9 +35,8 @@ from ..segments import SegmentChain
 from ..tour import Tour, tour_through_poses
 from ..tour.model import snap_visits
 from . import bead
-from .alternating import alternating_headings
+from .alternating import alternating_visits
 from .base import Planner
-from .euclidean_tour import euclidean_tour
 from .region import Region, bounding_region, minimum_area_region
 from .tiling import BeadTiling, bead_half_length, phase_shape
 
@@ -79,12 +78,11 @@ def _best_heading(entries: np.ndarray, targets: np.ndarray, exits: np.ndarray, r
 
 
 def _pieces(local: np.ndarray, phase: int, tiling: BeadTiling, meta_rows: np.ndarray,
-            meta_columns: np.ndarray, direction: np.ndarray, rho: float):
+            centre_x: np.ndarray, direction: np.ndarray, rho: float):
     """For each serviced target: the path piece from its meta-bead's entry tip to its exit tip
     (padded to six segments) and the arc length of the target on it."""
     m = len(local)
     half = tiling.meta_half_length(phase)
-    centre_x = tiling.meta_centre_x(meta_rows, meta_columns, phase)
     axis_y = tiling.meta_axis_y(meta_rows, phase)
     # Target in the frame of its scaled bead, x along the direction of flight.
     u = direction * (local[:, 0] - centre_x)
@@ -146,10 +144,10 @@ def _phase(local: np.ndarray, remaining: np.ndarray, tiling: BeadTiling, bead_ro
     serviced, meta_rows, meta_columns = serviced[sweep], meta_rows[sweep], meta_columns[sweep]
     visit_pass, direction = visit_pass[sweep], direction[sweep]
 
-    starts, lengths, curvatures, s_piece, in_bead = _pieces(
-        local[serviced], phase, tiling, meta_rows, meta_columns, direction, rho)
     half = tiling.meta_half_length(phase)
     centre_x = tiling.meta_centre_x(meta_rows, meta_columns, phase)
+    starts, lengths, curvatures, s_piece, in_bead = _pieces(
+        local[serviced], phase, tiling, meta_rows, centre_x, direction, rho)
     entry_x = centre_x - direction * half
     exit_x = centre_x + direction * half
 
@@ -259,8 +257,8 @@ class RBTAPlanner(Planner):
         leftover_length = 0.0
         if len(leftovers):
             points = np.vstack([home[None, :2], local[leftovers]])
-            order = euclidean_tour(local[leftovers])
-            headings = np.concatenate([[home[2]], alternating_headings(local[leftovers][order])])
+            order, leftover_headings = alternating_visits(local[leftovers])
+            headings = np.concatenate([[home[2]], leftover_headings])
             excursion = tour_through_poses(points, np.concatenate([[0], order + 1]), headings, rho_m)
             visit_s[leftovers] = offset + excursion.visit_s_m[1:]
             chains.append(excursion.chain)
