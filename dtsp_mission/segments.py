@@ -102,6 +102,26 @@ class SegmentChain:
         keep = self.lengths_m >= min_length_m
         return SegmentChain(self.starts[keep], self.lengths_m[keep], self.curvatures_1_m[keep])
 
+    def between(self, start_s_m: float, end_s_m: float) -> "SegmentChain":
+        """The part of the chain from arc length ``start_s_m`` to ``end_s_m`` (clipped to
+        ``[0, length]``), as exact segments: the first starts at ``pose_at(start_s_m)``, the
+        lengths add up to ``end_s_m - start_s_m``.  Empty if ``end_s_m <= start_s_m``."""
+        offsets = self.offsets_m
+        start = float(np.clip(start_s_m, 0.0, offsets[-1]))
+        end = float(np.clip(end_s_m, 0.0, offsets[-1]))
+        if len(self) == 0 or end <= start:
+            return SegmentChain.empty()
+        first = int(np.clip(np.searchsorted(offsets, start, side="right") - 1, 0, len(self) - 1))
+        last = int(np.clip(np.searchsorted(offsets, end, side="left") - 1, first, len(self) - 1))
+        starts = self.starts[first:last + 1].copy()
+        lengths = self.lengths_m[first:last + 1].copy()
+        curvatures = self.curvatures_1_m[first:last + 1].copy()
+        cut = start - offsets[first]
+        starts[0] = advance(starts[0], cut, curvatures[0])
+        lengths[0] -= cut
+        lengths[-1] = end - max(offsets[last], start)
+        return SegmentChain(starts, np.maximum(lengths, 0.0), curvatures)
+
     def locate(self, s_m: np.ndarray | float) -> tuple[np.ndarray, np.ndarray]:
         """Segment index and offset within it for arc length(s) ``s_m`` in ``[0, length]``."""
         s_m = np.asarray(s_m, dtype=float)
@@ -115,18 +135,23 @@ class SegmentChain:
         index, within = self.locate(s_m)
         return advance(self.starts[index], within, self.curvatures_1_m[index])
 
-    def sample(self, max_step_m: float) -> np.ndarray:
-        """Poses along the whole chain, at most ``max_step_m`` apart, including every segment
-        start and the final end pose, shape (k, 3)."""
+    def sample_s(self, max_step_m: float) -> np.ndarray:
+        """Arc lengths at most ``max_step_m`` apart along the whole chain, including every
+        segment start and the total length, increasing."""
         if len(self) == 0:
-            return np.zeros((0, 3))
+            return np.zeros(0)
         pieces = np.maximum(1, np.ceil(self.lengths_m / max_step_m).astype(np.int64))
         segment = np.repeat(np.arange(len(self)), pieces)
         first = np.cumsum(pieces) - pieces
         fraction = (np.arange(len(segment)) - first[segment]) / pieces[segment]
-        poses = advance(self.starts[segment], fraction * self.lengths_m[segment],
-                        self.curvatures_1_m[segment])
-        return np.vstack([poses, self.ends()[-1:]])
+        return np.append(self.offsets_m[segment] + fraction * self.lengths_m[segment],
+                         self.length_m)
+
+    def sample(self, max_step_m: float) -> np.ndarray:
+        """Poses at :meth:`sample_s` arc lengths, shape (k, 3)."""
+        if len(self) == 0:
+            return np.zeros((0, 3))
+        return self.pose_at(self.sample_s(max_step_m))
 
     def project(self, index: np.ndarray, points_m: np.ndarray) -> np.ndarray:
         """Arc length within segment ``index[i]`` of the point of that segment nearest to

@@ -21,3 +21,51 @@ def assert_valid_tour(tour: Tour) -> None:
 @pytest.fixture
 def rng() -> np.random.Generator:
     return np.random.default_rng(20261122)
+
+
+def make_mission(count: int = 40, seed: int = 7, rho_m: float = 80.0, centre=(46.8, 6.95),
+                 span_m: float = 3000.0, **settings):
+    """A small planned mission around ``centre``: ``count`` seeded random targets."""
+    from dtsp_mission.frame import LocalFrame
+    from dtsp_mission.mission import MissionSettings, build_mission
+    from dtsp_mission.planning import get_planner
+    from dtsp_mission.targets.model import local_targets
+
+    frame = LocalFrame(*centre)
+    positions = np.random.default_rng(seed).uniform(-span_m / 2, span_m / 2, (count, 2))
+    targets = local_targets(positions).to_geodetic(frame)
+    targets = type(targets)(targets.latitudes_deg, targets.longitudes_deg,
+                            tuple(f"t{i}" for i in range(count)), 0, settings.pop("altitudes", None))
+    local = targets.in_frame(frame)
+    tour = get_planner("alternating").plan(local.positions_m, rho_m)
+    return build_mission(tour, frame, targets, MissionSettings(**settings))
+
+
+def free_udp_port() -> int:
+    import socket
+    with socket.socket(socket.AF_INET, socket.SOCK_DGRAM) as probe:
+        probe.bind(("127.0.0.1", 0))
+        return probe.getsockname()[1]
+
+
+@pytest.fixture(scope="session")
+def mavsdk_mission_raw():
+    """MAVSDK's ``MissionRaw`` plugin of a ground station connected over loopback UDP to a
+    MAVSDK autopilot component: the real importers (QGC .plan, Mission Planner text) need a
+    system, and this is the smallest real one."""
+    from mavsdk import ComponentType, Configuration, Mavsdk
+    from mavsdk.logging import LogLevel, log_subscribe
+    from mavsdk.plugins.mission_raw import MissionRaw
+
+    log_subscribe(lambda level, message, file, line: level < LogLevel.ERROR)
+    port = free_udp_port()
+    ground = Mavsdk(Configuration.create_with_component_type(ComponentType.GROUND_STATION))
+    ground.add_any_connection(f"udpin://127.0.0.1:{port}")
+    vehicle = Mavsdk(Configuration.create_with_component_type(ComponentType.AUTOPILOT))
+    vehicle.add_any_connection(f"udpout://127.0.0.1:{port}")
+    vehicle.server_component()
+    system = ground.first_autopilot(10.0)
+    assert system is not None, "the loopback MAVSDK autopilot did not appear"
+    yield MissionRaw(system)
+    vehicle.destroy()
+    ground.destroy()

@@ -50,21 +50,47 @@ def test_rbta_falls_back_when_too_few_targets(tmp_path):
     assert not (tmp_path / "u.json").exists()
 
 
-@pytest.mark.parametrize("content, message", [
-    ("", "the file is empty"),
-    ("x,y\n", "no targets below the header"),
-    ("lat,lon\n1,2\n", "must name columns 'x' and 'y'"),
-    ("x,y\n1,2\n3,abc\n", "line 3: x and y must be numbers"),
-    ("x,y\n1,2\nnan,4\n", "line 3: x and y must be finite"),
-])
-def test_bad_target_files_give_a_clear_message_exit_2_and_no_output(tmp_path, content, message):
-    targets = tmp_path / "targets.csv"
+BAD_INPUTS = [
+    ("targets.csv", "", [], "the file is empty"),
+    ("targets.csv", "x,y\n", [], "no targets below the header"),
+    ("targets.csv", "x,y\n10,20\n", [], "holds 1 target(s)"),
+    ("targets.csv", "x,y\n10,20\n10,20\n", [], "holds 1 target(s)"),
+    ("targets.csv", "lat,lon,height\n1,2,3\n", [], "unknown column 'height'"),
+    ("targets.csv", "easting,northing\n1,2\n", [], "unknown column 'easting'"),
+    ("targets.csv", "x,y\n1,2\n3,abc\n", [], "line 3: y must be a number"),
+    ("targets.csv", "x,y\n1,2\nnan,4\n", [], "line 3: x must be a finite number"),
+    ("targets.csv", "lat,lon\n47,8\n91,8\n", [], "latitude 91.0 is not a number between -90"),
+    ("targets.csv", "lat,lon\n47,8\n47,181\n", [], "longitude 181.0 is not a number between"),
+    ("targets.csv", "lat,lon\n40,8\n44,8\n", [], "too large an area for one flat mission frame"),
+    ("targets.csv", "lat,lon,alt\n47,8,50\n47.01,8,-5\n", [], "altitude -5.0 m must be a number above 0"),
+    ("targets.csv", "lat,lon\n47,8\n47.01,8\n", ["--alt", "-10"], "altitude must be a number above 0"),
+    ("targets.csv", "lat,lon\n47,8\n47.01,8\n", ["--radius", "0"], "turn radius must be a positive number"),
+    ("targets.csv", "lat,lon\n47,8\n47.01,8\n", ["--radius", "nan"], "turn radius must be a positive number"),
+    ("targets.csv", "x,y\n0,0\n900,0\n", [], "give --origin LAT,LON"),
+    ("targets.geojson", "{not json", [], "not valid JSON"),
+    ("targets.geojson", '{"type": "FeatureCollection", "features": []}', [], "no Point features"),
+    ("targets.geojson", '{"type": "LineString", "coordinates": [[8, 47], [8.1, 47]]}', [],
+     "'LineString' geometry is not supported"),
+    ("targets.txt.gz", "x", [], "cannot tell the format"),
+]
+
+
+@pytest.mark.parametrize("name, content, extra, message", BAD_INPUTS)
+def test_bad_input_gives_a_clear_message_exit_2_and_leaves_outputs_alone(tmp_path, name, content,
+                                                                         extra, message):
+    targets = tmp_path / name
     targets.write_text(content)
-    out = tmp_path / "tour.json"
-    result = run(str(targets), "--radius", "80", "-o", str(out))
-    assert result.returncode == 2
+    kept = tmp_path / "kept.plan"
+    kept.write_text("the previous mission\n")
+    fresh = tmp_path / "fresh.plan"
+    arguments = [str(targets), "-o", str(kept), "-o", str(fresh), *extra]
+    if "--radius" not in extra:
+        arguments += ["--radius", "80"]
+    result = run(*arguments)
+    assert result.returncode == 2, result.stdout + result.stderr
     assert message in result.stderr
-    assert not out.exists()
+    assert kept.read_text() == "the previous mission\n" and not fresh.exists()
+    assert not list(tmp_path.glob(".*.part"))
 
 
 def test_bad_radius_and_missing_file(tmp_path):

@@ -44,3 +44,17 @@ def test_wrap_angle_range():
     wrapped = wrap_angle(values)
     assert ((wrapped > -math.pi) & (wrapped <= math.pi)).all()
     assert np.allclose(np.cos(wrapped), np.cos(values)) and np.allclose(np.sin(wrapped), np.sin(values))
+
+
+def test_between_cuts_exact_pieces_that_join_up():
+    chain = SegmentChain(np.array([[0.0, 0.0, 0.0], [10.0, 0.0, 0.0]]),
+                         np.array([10.0, 5 * np.pi]), np.array([0.0, 0.2]))
+    total = chain.length_m
+    for start, end in [(0.0, total), (3.0, 8.0), (3.0, 12.0), (10.0, total), (12.5, 14.0)]:
+        piece = chain.between(start, end)
+        assert piece.length_m == pytest.approx(end - start, abs=1e-12)
+        assert np.allclose(piece.starts[0], chain.pose_at(start))
+        assert np.allclose(piece.ends()[-1], chain.pose_at(end))
+        inside = np.linspace(0, end - start, 7)
+        assert np.allclose(piece.pose_at(inside), chain.pose_at(start + inside))
+    assert len(chain.between(5.0, 5.0)) == 0

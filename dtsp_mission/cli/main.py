@@ -8,14 +8,13 @@ that fails to load is listed as broken (with the reason, under ``-v``) and the r
 from __future__ import annotations
 
 import logging
-from importlib.metadata import entry_points
 
 import click
 
 from .. import __version__
+from ..plugins import load_group
 
 COMMAND_GROUP = "dtsp_mission.commands"
-log = logging.getLogger("dtsp_mission")
 
 
 def _broken_command(name: str, error: BaseException) -> click.Command:
@@ -37,17 +36,14 @@ class PluginGroup(click.Group):
         if self._loaded:
             return
         self._loaded = True
-        for entry_point in sorted(entry_points(group=self._entry_point_group), key=lambda e: e.name):
-            if entry_point.name in self.commands:
+        loaded = load_group(self._entry_point_group, lambda c: isinstance(c, click.Command),
+                            "a click command")
+        for name, command in loaded.items():
+            if name in self.commands:
                 continue
-            try:
-                command = entry_point.load()
-                if not isinstance(command, click.Command):
-                    raise TypeError(f"{entry_point.value} is not a click command")
-            except Exception as error:  # a broken plugin must not break the CLI
-                log.warning("command plugin %r is broken: %r", entry_point.name, error)
-                command = _broken_command(entry_point.name, error)
-            self.add_command(command, entry_point.name)
+            if isinstance(command, Exception):
+                command = _broken_command(name, command)
+            self.add_command(command, name)
 
     def list_commands(self, ctx: click.Context) -> list[str]:
         self._load()

@@ -33,3 +33,66 @@ radius_option = click.option(
     help="Minimum turn radius rho of the aircraft, in metres.")
 seed_option = click.option("--seed", type=int, default=0, show_default=True,
                            help="Seed of every random choice; the same seed gives the same result.")
+
+
+class LatLonType(click.ParamType):
+    """``LAT,LON`` in decimal degrees."""
+
+    name = "LAT,LON"
+
+    def convert(self, value, param, ctx):
+        if isinstance(value, tuple):
+            return value
+        try:
+            latitude, longitude = (float(part) for part in str(value).split(","))
+        except ValueError:
+            self.fail(f"{value!r} is not LAT,LON in decimal degrees (for example 47.3977,8.5456)",
+                      param, ctx)
+        if not (-90 <= latitude <= 90 and -180 <= longitude <= 180):
+            self.fail(f"{value!r}: latitude must be within [-90, 90] and longitude within "
+                      "[-180, 180] degrees", param, ctx)
+        return latitude, longitude
+
+
+LAT_LON = LatLonType()
+
+#: The vehicle, defined once for every command that plans or flies.
+vehicle_options = [
+    click.option("--radius", "rho_m", type=float, metavar="METRES",
+                 help="Minimum turn radius rho of the aircraft, in metres (or give --airspeed "
+                      "and --max-bank)."),
+    click.option("--airspeed", "airspeed_m_s", type=float, metavar="M/S",
+                 help="Cruise airspeed in m/s: sets the mission speed and the flight time; with "
+                      "--max-bank it gives rho = v^2 / (g tan(bank))."),
+    click.option("--max-bank", "max_bank_deg", type=float, metavar="DEG",
+                 help="Largest bank angle in degrees, used with --airspeed to compute rho."),
+]
+
+
+def apply(options: list) -> Callable:
+    """Decorate a command with a list of click options, in order."""
+    def decorate(function: Callable) -> Callable:
+        for option in reversed(options):
+            function = option(function)
+        return function
+    return decorate
+
+
+def turn_radius_from(rho_m: float | None, airspeed_m_s: float | None,
+                     max_bank_deg: float | None) -> tuple[float, str]:
+    """The turn radius and where it came from, from the vehicle options."""
+    from ..vehicle import bank_for_radius_deg, turn_radius_m
+    if max_bank_deg is not None:
+        if rho_m is not None:
+            raise UserError("give either --radius or --airspeed with --max-bank, not both")
+        if airspeed_m_s is None:
+            raise UserError("--max-bank needs --airspeed to compute the turn radius")
+        rho = turn_radius_m(airspeed_m_s, max_bank_deg)
+        return rho, (f"rho {rho:.1f} m from airspeed {airspeed_m_s:g} m/s and "
+                     f"{max_bank_deg:g} deg bank")
+    if rho_m is None:
+        raise UserError("give the turn radius: --radius METRES, or --airspeed and --max-bank")
+    if airspeed_m_s is not None and rho_m > 0 and airspeed_m_s > 0:
+        return rho_m, (f"rho {rho_m:g} m (a {bank_for_radius_deg(airspeed_m_s, rho_m):.0f} deg "
+                       f"bank at {airspeed_m_s:g} m/s)")
+    return rho_m, f"rho {rho_m:g} m"

@@ -1,4 +1,4 @@
-"""``dtsp-mission plan``: plan a tour through targets and write it."""
+"""``dtsp-mission plan``: the main job -- targets in, checked tour and mission files out."""
 
 from __future__ import annotations
 
@@ -6,17 +6,99 @@ import time
 
 import click
 import numpy as np
+import shapely
 
+from ..export import exporter_for
+from ..frame import LocalFrame
+from ..mission import Autopilot, MissionSettings, build_mission
 from ..planning import TilingUnavailable, get_planner, planners
 from ..planning.lower_bounds import lower_bound
-from ..targets import read_local_csv
-from ..tour import write_tour
-from .options import radius_option, reports_errors
+from ..targets import GeoTargets, Targets, random_targets, read_targets
+from ..targets.geojson_file import read_geojson
+from .options import (LAT_LON, UserError, apply, reports_errors, seed_option, turn_radius_from,
+                      vehicle_options)
+
+
+def _targets(targets_file: str | None, random_count: int | None, area_file: str | None,
+             seed: int) -> GeoTargets | Targets:
+    if random_count is None:
+        if targets_file is None:
+            raise UserError("give a TARGETS_FILE, or --random N with --area")
+        targets = read_targets(targets_file)
+        if area_file is not None:
+            if not isinstance(targets, GeoTargets):
+                raise UserError("--area needs targets in lat/lon")
+            targets = targets.with_area(_area(area_file))
+        return targets
+    if area_file is None and targets_file is None:
+        raise UserError("--random needs a survey area: --area AREA.geojson (a Polygon)")
+    source = read_geojson(area_file or targets_file)
+    if source.area_deg is None:
+        raise UserError(f"{area_file or targets_file}: no Polygon feature to draw --random targets in")
+    if len(source) and area_file is None:
+        raise UserError(f"{targets_file} holds targets; --random draws its own (use --area)")
+    return random_targets(source.area_deg, random_count, seed)
+
+
+def _area(area_file: str) -> np.ndarray:
+    area = read_geojson(area_file).area_deg
+    if area is None:
+        raise UserError(f"{area_file}: no Polygon feature (the survey area)")
+    return area
+
+
+def _frame(targets: GeoTargets | Targets, origin) -> tuple[Targets, GeoTargets | None, LocalFrame | None]:
+    """Local targets, their degrees and the frame (the last two None for local-only input)."""
+    if isinstance(targets, GeoTargets):
+        if origin is not None:
+            raise UserError("--origin is for targets in local x/y metres; these are in lat/lon")
+        frame = LocalFrame.around(targets.latitudes_deg, targets.longitudes_deg)
+        return targets.in_frame(frame), targets, frame
+    if origin is None:
+        return targets, None, None
+    frame = LocalFrame(*origin)
+    geodetic = targets.to_geodetic(frame)
+    frame.check_extent(geodetic.latitudes_deg, geodetic.longitudes_deg)
+    return targets, geodetic, frame
+
+
+def _duration(seconds: float) -> str:
+    minutes = int(round(seconds / 60))
+    return f"{minutes // 60} h {minutes % 60:02d} min" if minutes >= 60 else f"{seconds / 60:.1f} min"
 
 
 @click.command()
-@click.argument("targets_file", type=click.Path(dir_okay=False))
-@radius_option
+@click.argument("targets_file", required=False, type=click.Path(dir_okay=False))
+@click.option("--random", "random_count", type=int, metavar="N",
+              help="Plan through N seeded uniform random targets inside the --area polygon.")
+@click.option("--area", "area_file", type=click.Path(dir_okay=False), metavar="AREA.geojson",
+              help="Survey area (a GeoJSON Polygon): for --random, the lower bound and the plot.")
+@seed_option
+@click.option("--origin", type=LAT_LON, help="Place targets given in local x/y metres on the "
+              "earth: LAT,LON of their (0, 0).")
+@apply(vehicle_options)
+@click.option("--alt", "altitude_m", type=float, default=100.0, show_default=True,
+              metavar="METRES", help="Cruise altitude above home (targets with an 'alt' use theirs).")
+@click.option("--home", "home_deg", type=LAT_LON,
+              help="Launch and home position (default: the centre of the targets).")
+@click.option("--home-amsl", "home_amsl_m", type=float, default=0.0, show_default=True,
+              metavar="METRES", help="Home altitude above mean sea level (for the .plan).")
+@click.option("--launch-bearing", "launch_bearing_deg", type=float, metavar="DEG",
+              help="Take-off direction, compass degrees (default: towards the first target).")
+@click.option("--landing-bearing", "landing_bearing_deg", type=float, metavar="DEG",
+              help="Landing direction, compass degrees (default: the launch bearing).")
+@click.option("--autopilot", type=click.Choice(["ardupilot", "px4"]), default="ardupilot",
+              show_default=True, help="Autopilot flavour of the mission.")
+@click.option("--return", "return_mode", type=click.Choice(["rtl", "land", "none"]),
+              help="After the last target: RTL, a landing at home, or nothing "
+                   "(default: rtl for ArduPilot, land for PX4).")
+@click.option("--tolerance", "tolerance_m", type=float, metavar="METRES",
+              help="Largest distance between the exact path and the waypoint polyline "
+                   "(default 2 % of rho; the discretiser uses a quarter of it when the "
+                   "item budget allows).")
+@click.option("--max-items", type=int, metavar="N",
+              help="Mission slots of the vehicle (default 700 for ArduPilot, home included; "
+                   "500 for PX4).")
 @click.option("--algorithm", default="auto", show_default=True,
               help="Planner: " + ", ".join(sorted(planners())) + ".")
 @click.option("--region", default="bounding", show_default=True,
@@ -26,36 +108,85 @@ from .options import radius_option, reports_errors
               help="If the RBTA cannot tile (too few targets), plan with the Alternating "
                    "Algorithm instead of failing.")
 @click.option("-o", "--output", "outputs", multiple=True, type=click.Path(dir_okay=False),
-              help="Write the tour here (tour JSON). Repeatable.")
+              help="Write here; the format follows the extension (.plan, .waypoints, .geojson, "
+                   ".json tour) unless --format says. Repeatable.")
+@click.option("--format", "format_name", help="Output format for every -o, whatever its extension.")
+@click.option("--plot", "plot_file", type=click.Path(dir_okay=False), metavar="PNG",
+              help="Draw targets, path and waypoints to this PNG file.")
 @reports_errors
-def plan(targets_file: str, rho_m: float, algorithm: str, region: str, fallback: bool,
-         outputs: tuple[str, ...]) -> None:
-    """Plan a closed Dubins tour through the targets in TARGETS_FILE.
+def plan(targets_file, random_count, area_file, seed, origin, rho_m, airspeed_m_s, max_bank_deg,
+         altitude_m, home_deg, home_amsl_m, launch_bearing_deg, landing_bearing_deg, autopilot,
+         return_mode, tolerance_m, max_items, algorithm, region, fallback, outputs, format_name,
+         plot_file) -> None:
+    """Plan a Dubins tour through the targets and write it as a mission.
 
-    TARGETS_FILE is a CSV with columns x and y in metres (a local frame: x east, y north).
-    Example: dtsp-mission plan examples/site-local.csv --radius 80 -o tour.json
+    TARGETS_FILE: CSV with lat,lon columns (optional alt, name), or local x,y metres (with
+    --origin to place them), or GeoJSON Point features (a Polygon feature is the survey area).
+
+    Example: dtsp-mission plan examples/site-inspection.csv --radius 80 --alt 120 -o mission.plan
     """
-    targets = read_local_csv(targets_file)
-    if targets.merged_duplicates:
-        click.echo(f"note: {targets.merged_duplicates} duplicate targets merged "
-                   f"({len(targets.positions_m)} remain)", err=True)
+    writers = [(output, exporter_for(output, format_name)) for output in outputs]
+    rho, rho_source = turn_radius_from(rho_m, airspeed_m_s, max_bank_deg)
+    targets = _targets(targets_file, random_count, area_file, seed)
+    if len(targets) < 2:
+        raise UserError(f"{targets_file or 'the input'} holds {len(targets)} target(s) after "
+                        "merging duplicates; a tour needs at least 2 (for one point, fly a "
+                        "single waypoint)")
+    local, geodetic, frame = _frame(targets, origin)
+    needs_mission = [output for output, writer in writers if writer.needs_mission]
+    if needs_mission and frame is None:
+        raise UserError(f"{needs_mission[0]}: a mission needs targets in degrees; these are "
+                        "local x/y metres, so give --origin LAT,LON (or write only a .json tour)")
+    if local.merged_duplicates:
+        click.echo(f"note: {local.merged_duplicates} duplicate targets merged "
+                   f"({len(local)} remain)", err=True)
+    area_m = None
+    if geodetic is not None and geodetic.area_deg is not None:
+        area_m = frame.to_local(geodetic.area_deg[:, 0], geodetic.area_deg[:, 1])
+        outside = int((~shapely.contains_xy(shapely.Polygon(area_m), *local.positions_m.T)).sum())
+        if outside:
+            click.echo(f"note: {outside} targets lie outside the survey area", err=True)
+    click.echo(f"{len(local)} targets; {rho_source}")
+
     parameters = {"region": region} if algorithm in ("rbta", "auto") else {}
     started = time.perf_counter()
     try:
-        tour = get_planner(algorithm, **parameters).plan(targets.positions_m, rho_m)
+        tour = get_planner(algorithm, **parameters).plan(local.positions_m, rho)
     except TilingUnavailable as error:
         if not fallback:
             raise
         click.echo(f"note: {error}; planning with the Alternating Algorithm instead", err=True)
-        tour = get_planner("alternating").plan(targets.positions_m, rho_m)
+        tour = get_planner("alternating").plan(local.positions_m, rho)
     elapsed = time.perf_counter() - started
-    positions = targets.positions_m
-    area = max(float(np.ptp(positions[:, 0]) * np.ptp(positions[:, 1])), 1.0)
-    bound = lower_bound(positions, rho_m, area)
-    click.echo(f"planner {tour.planner}: {len(positions)} targets, tour {tour.length_m:,.1f} m "
-               f"({elapsed:.2f} s)")
-    click.echo(f"lower bound {bound.value_m:,.1f} m [{bound.kind}]: ratio "
-               f"{tour.length_m / bound.value_m:.3f}")
+    _report_tour(tour, local.positions_m, area_m, elapsed)
+
+    product = tour
+    if frame is not None:
+        settings = MissionSettings(autopilot, altitude_m, airspeed_m_s, home_deg, home_amsl_m,
+                                   launch_bearing_deg, landing_bearing_deg, return_mode,
+                                   tolerance_m, max_items)
+        product = build_mission(tour, frame, geodetic, settings)
+        _report_mission(product)
+    elif airspeed_m_s:
+        click.echo(f"flight time of the tour at {airspeed_m_s:g} m/s: "
+                   f"{_duration(tour.length_m / airspeed_m_s)}")
+    for output, writer in writers:
+        writer.write(product, output)
+        click.echo(f"wrote {output} ({writer.description})")
+    if plot_file:
+        from ..plot import draw_plan
+        draw_plan(product, plot_file, area_m)
+        click.echo(f"wrote {plot_file} (plot)")
+
+
+def _report_tour(tour, positions: np.ndarray, area_m: np.ndarray | None, elapsed: float) -> None:
+    if area_m is not None:
+        area = float(shapely.Polygon(area_m).area)
+    else:
+        area = max(float(np.ptp(positions[:, 0]) * np.ptp(positions[:, 1])), 1.0)
+    bound = lower_bound(positions, tour.rho_m, area)
+    click.echo(f"planner {tour.planner}: tour {tour.length_m:,.1f} m ({elapsed:.2f} s); lower "
+               f"bound {bound.value_m:,.1f} m [{bound.kind}], ratio {tour.length_m / bound.value_m:.3f}")
     for phase in tour.report.get("phases", []):
         click.echo(f"  phase {phase['phase']}: meta-beads of {phase['meta_bead_beads'][0]}x"
                    f"{phase['meta_bead_beads'][1]} beads, {phase['serviced']} targets, "
@@ -66,6 +197,17 @@ def plan(targets_file: str, rho_m: float, algorithm: str, region: str, fallback:
     if "leftovers" in tour.report:
         click.echo(f"  leftovers (Alternating Algorithm): {tour.report['leftovers']} targets, "
                    f"{tour.report['leftover_length_m']:,.1f} m")
-    for output in outputs:
-        write_tour(tour, output)
-        click.echo(f"wrote {output}")
+
+
+def _report_mission(mission) -> None:
+    summary = mission.summary
+    flavour = "ArduPilot" if mission.autopilot == Autopilot.ARDUPILOTMEGA else "PX4"
+    click.echo(f"mission ({flavour}): {summary['items']} items, {summary['vehicle_slots']} "
+               f"vehicle slots; waypoints within {mission.tolerance_m:.2f} m of the exact path")
+    line = f"flight: {summary['flight_length_m'] / 1e3:,.2f} km from take-off to the return"
+    if "flight_time_s" in summary:
+        line += f", {_duration(summary['flight_time_s'])} at {mission.cruise_speed_m_s:g} m/s"
+    click.echo(line)
+    for note in mission.notes:
+        click.echo(f"note: {note}", err=True)
+

@@ -7,32 +7,21 @@ group (a :class:`~dtsp_mission.planning.base.Planner` subclass); :func:`planners
 
 from __future__ import annotations
 
-import logging
-from importlib.metadata import entry_points
 from typing import Any
 
 from ..errors import InputError
+from ..plugins import load_group
 from .base import Planner
 from .region import Region, bounding_region, minimum_area_region
 from .tiling import TilingUnavailable
 
 PLANNER_GROUP = "dtsp_mission.planners"
-log = logging.getLogger(__name__)
 
 
 def planners() -> dict[str, type[Planner] | Exception]:
     """Installed planners by name; a plugin that fails to load maps to the error it raised."""
-    found: dict[str, type[Planner] | Exception] = {}
-    for entry_point in sorted(entry_points(group=PLANNER_GROUP), key=lambda e: e.name):
-        try:
-            planner = entry_point.load()
-            if not (isinstance(planner, type) and issubclass(planner, Planner)):
-                raise TypeError(f"{entry_point.value} is not a Planner subclass")
-            found[entry_point.name] = planner
-        except Exception as error:  # a broken plugin must not break planning
-            log.warning("planner plugin %r is broken: %r", entry_point.name, error)
-            found[entry_point.name] = error
-    return found
+    return load_group(PLANNER_GROUP, lambda p: isinstance(p, type) and issubclass(p, Planner),
+                      "a Planner subclass")
 
 
 def get_planner(name: str, **parameters: Any) -> Planner:

@@ -18,7 +18,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from ..errors import TourInvalidError
-from ..segments import wrap_angle
+from ..segments import SegmentChain, wrap_angle
 from .model import Tour
 
 #: The project-wide tolerance, in turn radii (positions) and radians (headings).
@@ -63,9 +63,16 @@ def _finite_max(values: np.ndarray) -> float:
 
 def check_tour(tour: Tour, tolerance_rho: float = TOLERANCE_RHO) -> CheckReport:
     """Measure ``tour`` against the rules in the module docstring; never raises for a bad tour."""
+    return check_path(tour.chain, tour.rho_m, tour.targets_m, tour.visit_s_m, closed=True,
+                      tolerance_rho=tolerance_rho)
+
+
+def check_path(chain: SegmentChain, rho_m: float, targets_m: np.ndarray, visit_s_m: np.ndarray,
+               closed: bool, tolerance_rho: float = TOLERANCE_RHO) -> CheckReport:
+    """The same rules for any chain of segments; an open path (``closed=False``) need not
+    end where it starts."""
     problems: list[str] = []
-    chain = tour.chain
-    rho = float(tour.rho_m)
+    rho = float(rho_m)
     if not np.isfinite(rho) or rho <= 0:
         problems.append(f"turn radius {rho!r} is not a positive number")
         rho = float("nan")
@@ -88,7 +95,7 @@ def check_tour(tour: Tour, tolerance_rho: float = TOLERANCE_RHO) -> CheckReport:
 
     max_gap = max_heading = 0.0
     if len(chain) == 0:
-        if len(tour.targets_m) > 0:
+        if len(targets_m) > 0:
             problems.append("the tour has no segments")
     elif finite:
         ends = chain.ends()
@@ -102,18 +109,19 @@ def check_tour(tour: Tour, tolerance_rho: float = TOLERANCE_RHO) -> CheckReport:
             problems.append(f"not C1-continuous at {int(broken[:-1].sum())} joints (first after "
                             f"segment {first}: gap {gaps[first]:.3g} m, heading jump "
                             f"{heading_errors[first]:.3g} rad)")
-        if broken[-1]:
+        if closed and broken[-1]:
             problems.append(f"not closed: the end misses the start by {gaps[-1]:.3g} m and "
                             f"{heading_errors[-1]:.3g} rad")
 
     max_miss = 0.0
-    visits = tour.visit_s_m
-    if len(tour.targets_m) and len(chain) and finite:
+    targets_m = np.asarray(targets_m, dtype=float).reshape(-1, 2)
+    visits = np.asarray(visit_s_m, dtype=float).reshape(-1)
+    if len(targets_m) and len(chain) and finite:
         on_tour = np.isfinite(visits) & (visits >= -tolerance_m) & (visits <= chain.length_m + tolerance_m)
         if not on_tour.all():
             problems.append(f"{int((~on_tour).sum())} visits lie outside the tour's arc length")
         poses = chain.pose_at(np.clip(np.where(on_tour, visits, 0.0), 0.0, chain.length_m))
-        misses = np.hypot(*(poses[:, :2] - tour.targets_m).T)
+        misses = np.hypot(*(poses[:, :2] - targets_m).T)
         misses = np.where(on_tour, misses, np.inf)
         max_miss = _finite_max(misses)
         missed = misses > tolerance_m
@@ -121,5 +129,5 @@ def check_tour(tour: Tour, tolerance_rho: float = TOLERANCE_RHO) -> CheckReport:
             first = int(np.argmax(missed))
             problems.append(f"{int(missed.sum())} targets are not on the path (first: target "
                             f"{first}, missed by {misses[first]:.3g} m)")
-    return CheckReport(tuple(problems), len(chain), len(tour.targets_m), chain.length_m,
+    return CheckReport(tuple(problems), len(chain), len(targets_m), chain.length_m,
                        max_gap, max_heading, max_curvature_ratio, max_miss)

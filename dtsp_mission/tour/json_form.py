@@ -24,8 +24,15 @@ FORMAT = "dtsp-mission/tour"
 VERSION = 1
 
 
-def tour_to_dict(tour: Tour) -> dict[str, Any]:
-    """The tour as plain JSON-ready data."""
+def tour_to_dict(tour: Tour, origin_deg: tuple[float, float] | None = None) -> dict[str, Any]:
+    """The tour as plain JSON-ready data; ``origin_deg`` (latitude, longitude) places the local
+    frame on the earth (azimuthal equidistant on WGS84 centred there)."""
+    frame: dict[str, Any] = {"type": "local", "x": "east", "y": "north",
+                             "heading": "radians counter-clockwise from east"}
+    if origin_deg is not None:
+        frame["origin"] = {"latitude_deg": float(origin_deg[0]),
+                           "longitude_deg": float(origin_deg[1]),
+                           "projection": "azimuthal equidistant, WGS84"}
     chain = tour.chain
     segments = []
     for (x, y, heading), length, curvature in zip(chain.starts.tolist(), chain.lengths_m.tolist(),
@@ -40,7 +47,7 @@ def tour_to_dict(tour: Tour) -> dict[str, Any]:
     return {
         "format": FORMAT,
         "version": VERSION,
-        "frame": {"type": "local", "x": "east", "y": "north", "heading": "radians counter-clockwise from east"},
+        "frame": frame,
         "rho_m": tour.rho_m,
         "length_m": tour.length_m,
         "planner": {"name": tour.planner, "parameters": tour.parameters, "report": tour.report},
@@ -118,13 +125,26 @@ def _records(items: list, name: str) -> list[dict]:
     return items
 
 
-def dumps(tour: Tour) -> str:
-    return json.dumps(tour_to_dict(tour), indent=1, allow_nan=False) + "\n"
+def dumps(tour: Tour, origin_deg: tuple[float, float] | None = None) -> str:
+    return json.dumps(tour_to_dict(tour, origin_deg), indent=1, allow_nan=False) + "\n"
 
 
-def write_tour(tour: Tour, path: str | os.PathLike) -> Path:
+def write_tour(tour: Tour, path: str | os.PathLike,
+               origin_deg: tuple[float, float] | None = None) -> Path:
     """Write the tour's JSON form atomically."""
-    return write_atomic(path, dumps(tour))
+    return write_atomic(path, dumps(tour, origin_deg))
+
+
+def origin_from_dict(data: dict[str, Any]) -> tuple[float, float] | None:
+    """The (latitude, longitude) origin of a tour document's frame, if it has one."""
+    frame = data.get("frame") if isinstance(data, dict) else None
+    origin = frame.get("origin") if isinstance(frame, dict) else None
+    if origin is None:
+        return None
+    if not isinstance(origin, dict):
+        raise FileFormatError("tour: 'frame.origin' must be an object")
+    return (_number(origin, "latitude_deg", "frame.origin"),
+            _number(origin, "longitude_deg", "frame.origin"))
 
 
 def read_tour(path: str | os.PathLike) -> Tour:

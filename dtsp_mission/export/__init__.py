@@ -1,0 +1,44 @@
+"""Exporters: the mission (or tour) as files other tools read.
+
+Every exporter, built-in or third-party, registers in the ``dtsp_mission.exporters``
+entry-point group as an :class:`Exporter` subclass; :func:`exporters` lists them and
+:func:`exporter_for` picks one from ``--format`` or the file extension.
+"""
+
+from __future__ import annotations
+
+import os
+from pathlib import Path
+
+from ..errors import InputError
+from ..plugins import load_group
+from .base import Exporter
+
+EXPORTER_GROUP = "dtsp_mission.exporters"
+
+
+def exporters() -> dict[str, type[Exporter] | Exception]:
+    """Installed exporters by name; a plugin that fails to load maps to its error."""
+    return load_group(EXPORTER_GROUP, lambda e: isinstance(e, type) and issubclass(e, Exporter),
+                      "an Exporter subclass")
+
+
+def exporter_for(path: str | os.PathLike, format_name: str | None = None) -> Exporter:
+    """The exporter named ``format_name``, or else the one whose extensions match ``path``."""
+    available = {n: e for n, e in exporters().items() if not isinstance(e, Exception)}
+    if format_name is not None:
+        if format_name not in available:
+            raise InputError(f"unknown output format {format_name!r} (installed: "
+                             f"{', '.join(sorted(available))})")
+        return available[format_name]()
+    name = Path(path).name.lower()
+    matches = [(len(ext), n) for n, e in available.items() for ext in e.extensions
+               if name.endswith(ext)]
+    if not matches:
+        known = ", ".join(sorted(ext for e in available.values() for ext in e.extensions))
+        raise InputError(f"{path}: cannot tell the output format from the file name; use one of "
+                         f"{known}, or --format")
+    return available[max(matches)[1]]()
+
+
+__all__ = ["EXPORTER_GROUP", "Exporter", "exporter_for", "exporters"]

@@ -1,0 +1,36 @@
+"""The exporter interface: one subclass per file format, registered as a plugin."""
+
+from __future__ import annotations
+
+import os
+from pathlib import Path
+
+from ..errors import InputError
+from ..files import write_atomic
+from ..mission import Mission
+from ..tour import Tour
+
+
+class Exporter:
+    """Writes a mission (or, for formats that allow it, a bare tour) to a file.
+
+    Subclasses set ``name``, ``extensions`` (lower case, with the dot), ``description`` and
+    ``needs_mission``, and implement :meth:`render`.  :meth:`write` is the public method: it
+    checks the input, renders the whole file in memory and writes it atomically, so a failure
+    never leaves a half-written file.
+    """
+
+    name: str = ""
+    extensions: tuple[str, ...] = ()
+    description: str = ""
+    needs_mission: bool = True
+
+    def write(self, product: Mission | Tour, path: str | os.PathLike) -> Path:
+        if self.needs_mission and not isinstance(product, Mission):
+            raise InputError(f"{path}: a {self.description or self.name} needs a mission in "
+                             "degrees; give targets in lat/lon, or local x/y with --origin")
+        return write_atomic(path, self.render(product))
+
+    def render(self, product: Mission | Tour) -> str | bytes:
+        """The complete file content."""
+        raise NotImplementedError

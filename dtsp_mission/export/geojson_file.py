@@ -1,0 +1,72 @@
+"""GeoJSON (RFC 7946) for GIS tools: the flown path, the targets, the waypoints and home.
+
+Positions are ``[longitude, latitude]`` in WGS84 degrees; altitudes (metres above home) are
+in the properties, because a GeoJSON third coordinate would mean height above the ellipsoid.
+The path is sampled from the exact segments every 2 degrees of turn (lines only at their
+ends), so it stays within ``rho (1 - cos 1 deg)`` (1.5e-4 rho) of the exact path.
+"""
+
+from __future__ import annotations
+
+import json
+import math
+
+import numpy as np
+
+from ..mission import Mission
+from ..mission.discretise import candidate_s
+from .base import Exporter
+
+PATH_STEP_RAD = math.radians(2.0)
+
+
+def _point(latitude: float, longitude: float, properties: dict) -> dict:
+    return {"type": "Feature", "geometry": {"type": "Point", "coordinates": [longitude, latitude]},
+            "properties": properties}
+
+
+def geojson_dict(mission: Mission) -> dict:
+    """The mission as a GeoJSON FeatureCollection."""
+    path = mission.path
+    s, _ = candidate_s(path.chain, PATH_STEP_RAD, np.zeros(0), 0.0)
+    latitudes, longitudes = mission.frame.to_geodetic(path.chain.pose_at(s)[:, :2])
+    features = [{
+        "type": "Feature",
+        "geometry": {"type": "LineString",
+                     "coordinates": np.column_stack([longitudes, latitudes]).tolist()},
+        "properties": {"kind": "flight_path", "length_m": path.chain.length_m,
+                       "rho_m": mission.rho_m, "tour_length_m": mission.tour.length_m,
+                       "planner": mission.tour.planner},
+    }]
+    home = mission.home
+    features.append(_point(home.latitude_deg, home.longitude_deg,
+                           {"kind": "home", "altitude_amsl_m": home.altitude_amsl_m}))
+    item_of_target = mission.target_items
+    order = np.argsort(path.target_s_m, kind="stable")
+    rank = np.empty(len(order), dtype=int)
+    rank[order] = np.arange(len(order))
+    for target, item_index in enumerate(item_of_target):
+        item = mission.items[item_index]
+        properties = {"kind": "target", "target": target, "visit": int(rank[target]),
+                      "item": item_index, "altitude_m": item.altitude_m,
+                      "s_m": float(path.target_s_m[target])}
+        if mission.target_names is not None:
+            properties["name"] = mission.target_names[target]
+        features.append(_point(item.latitude_deg, item.longitude_deg, properties))
+    for index, item in enumerate(mission.items):
+        if item.has_position:
+            features.append(_point(item.latitude_deg, item.longitude_deg,
+                                   {"kind": "waypoint", "item": index, "command": int(item.command),
+                                    "role": item.role, "altitude_m": item.altitude_m}))
+    return {"type": "FeatureCollection", "features": features}
+
+
+class GeoJSONExporter(Exporter):
+    """GeoJSON (``.geojson``)."""
+
+    name = "geojson"
+    extensions = (".geojson",)
+    description = "GeoJSON file"
+
+    def render(self, mission: Mission) -> str:
+        return json.dumps(geojson_dict(mission), allow_nan=False) + "\n"

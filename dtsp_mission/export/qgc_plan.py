@@ -1,0 +1,152 @@
+"""QGroundControl ``.plan`` files (JSON), written to pass QGroundControl's loader and MAVSDK's
+stricter importer.
+
+The rules those readers enforce (QGroundControl ``PlanMasterController::loadFromFile``,
+``MissionController::_loadJsonMissionFileV2``, ``SimpleMissionItem::load``; MAVSDK
+``mission_import.cpp``) are written out once, in :func:`plan_rule_violations`; the exporter
+checks its own output against them before writing anything.
+"""
+
+from __future__ import annotations
+
+import json
+import math
+from typing import Any
+
+from ..errors import TourInvalidError
+from ..mission import Mission
+from ..mission.commands import VEHICLE_TYPE_FIXED_WING
+from .base import Exporter
+
+#: QGroundControl's default fixed-wing cruise speed, written when no airspeed is given (QGC
+#: only uses it for time estimates).
+QGC_DEFAULT_CRUISE_SPEED_M_S = 15.0
+#: globalPlanAltitudeMode 1: altitudes relative to home.
+ALTITUDE_MODE_RELATIVE = 1
+
+
+def plan_dict(mission: Mission) -> dict[str, Any]:
+    """The mission as a QGroundControl plan document."""
+    items = []
+    for number, item in enumerate(mission.items, start=1):
+        items.append({
+            "type": "SimpleItem",
+            "command": int(item.command),
+            "frame": int(item.frame),
+            "params": [*item.params, item.latitude_deg, item.longitude_deg, item.altitude_m],
+            "autoContinue": bool(item.autocontinue),
+            "doJumpId": number,
+        })
+    home = mission.home
+    return {
+        "fileType": "Plan",
+        "version": 1,
+        "groundStation": "dtsp-mission",
+        "mission": {
+            "version": 2,
+            "firmwareType": int(mission.autopilot),
+            "vehicleType": VEHICLE_TYPE_FIXED_WING,
+            "cruiseSpeed": (mission.cruise_speed_m_s if mission.cruise_speed_m_s is not None
+                            else QGC_DEFAULT_CRUISE_SPEED_M_S),
+            "hoverSpeed": 5,
+            "globalPlanAltitudeMode": ALTITUDE_MODE_RELATIVE,
+            "plannedHomePosition": [home.latitude_deg, home.longitude_deg, home.altitude_amsl_m],
+            "items": items,
+        },
+        "geoFence": {"circles": [], "polygons": [], "version": 2},
+        "rallyPoints": {"points": [], "version": 2},
+    }
+
+
+def _is_number(value: Any) -> bool:
+    return isinstance(value, (int, float)) and not isinstance(value, bool) and math.isfinite(value)
+
+
+def _is_integer(value: Any) -> bool:
+    return isinstance(value, int) and not isinstance(value, bool)
+
+
+def plan_rule_violations(data: Any) -> list[str]:
+    """Every way ``data`` breaks the loader rules of QGroundControl and MAVSDK (empty if none)."""
+    if not isinstance(data, dict):
+        return ["the document is not a JSON object"]
+    problems = []
+    if data.get("fileType") != "Plan":
+        problems.append("fileType must be \"Plan\"")
+    if data.get("version") != 1:
+        problems.append(f"version must be 1 (QGroundControl rejects others), got {data.get('version')!r}")
+    if not isinstance(data.get("groundStation"), str):
+        problems.append("groundStation must be a string")
+    for key in ("mission", "geoFence", "rallyPoints"):
+        if not isinstance(data.get(key), dict):
+            problems.append(f"{key} must be an object")
+    if problems:
+        return problems
+    mission = data["mission"]
+    if mission.get("version") != 2:
+        problems.append(f"mission.version must be 2, got {mission.get('version')!r}")
+    for key in ("firmwareType", "vehicleType", "globalPlanAltitudeMode"):
+        if not _is_integer(mission.get(key)):
+            problems.append(f"mission.{key} must be an integer")
+    for key in ("cruiseSpeed", "hoverSpeed"):
+        if not _is_number(mission.get(key)):
+            problems.append(f"mission.{key} must be a number")
+    home = mission.get("plannedHomePosition")
+    if not (isinstance(home, list) and len(home) == 3 and all(map(_is_number, home))):
+        problems.append("mission.plannedHomePosition must be exactly 3 numbers (lat, lon, AMSL alt)")
+    items = mission.get("items")
+    if not isinstance(items, list):
+        problems.append("mission.items must be a list")
+        items = []
+    for number, item in enumerate(items):
+        problems += [f"mission.items[{number}]: {p}" for p in _item_violations(item)]
+    fence = data["geoFence"]
+    if not (isinstance(fence.get("circles"), list) and isinstance(fence.get("polygons"), list)
+            and fence.get("version") == 2):
+        problems.append("geoFence must have lists circles and polygons and version 2")
+    rally = data["rallyPoints"]
+    if not (isinstance(rally.get("points"), list) and rally.get("version") == 2):
+        problems.append("rallyPoints must have a list points and version 2")
+    return problems
+
+
+def _item_violations(item: Any) -> list[str]:
+    if not isinstance(item, dict):
+        return ["not an object"]
+    if item.get("type") != "SimpleItem":
+        return [f"type must be \"SimpleItem\", got {item.get('type')!r}"]
+    problems = []
+    for key in ("command", "frame", "doJumpId"):
+        if not _is_integer(item.get(key)):
+            problems.append(f"{key} must be an integer")
+    if not isinstance(item.get("autoContinue"), bool):
+        problems.append("autoContinue must be true or false (not 0/1)")
+    params = item.get("params")
+    if not (isinstance(params, list) and len(params) == 7):
+        problems.append("params must be a list of exactly 7 values")
+    else:
+        if not all(p is None or _is_number(p) for p in params[:4]):
+            problems.append("params 1-4 must be numbers or null")
+        if not all(_is_number(p) for p in params[4:]):
+            problems.append("params 5-7 (lat, lon, alt) must be numbers")
+    altitude_keys = [key in item for key in ("AltitudeMode", "Altitude", "AMSLAltAboveTerrain")]
+    if any(altitude_keys) and not (all(altitude_keys) and all(
+            _is_number(item[k]) for k in ("AltitudeMode", "Altitude", "AMSLAltAboveTerrain"))):
+        problems.append("AltitudeMode, Altitude and AMSLAltAboveTerrain go together, as numbers")
+    return problems
+
+
+class QGCPlanExporter(Exporter):
+    """QGroundControl plan (``.plan``)."""
+
+    name = "plan"
+    extensions = (".plan",)
+    description = "QGroundControl .plan file"
+
+    def render(self, mission: Mission) -> str:
+        data = plan_dict(mission)
+        problems = plan_rule_violations(data)
+        if problems:   # a bug here, never the user's input: say so instead of writing it
+            raise TourInvalidError("internal error, the .plan breaks loader rules: "
+                                   + "; ".join(problems))
+        return json.dumps(data, indent=2, allow_nan=False) + "\n"

@@ -1,0 +1,214 @@
+"""The discretiser's last step: from the exact flight path to mission items an autopilot flies.
+
+Item order: NAV_TAKEOFF (to the end of the climb-out), DO_CHANGE_SPEED (if an airspeed is
+given), NAV_WAYPOINTs along the path -- every target one of them, at the target's own
+coordinates and with a small acceptance radius, so that "item reached" means "target
+overflown" -- then the return: NAV_RETURN_TO_LAUNCH, or DO_LAND_START, the lead-out waypoints,
+the approach waypoint and NAV_LAND at home, or nothing.
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass
+
+import numpy as np
+
+from ..errors import InputError
+from ..frame import LocalFrame
+from ..targets import GeoTargets
+from ..tour import Tour
+from ..vehicle import bearing_to_heading_rad, heading_to_bearing_deg
+from .commands import AUTOPILOTS, Autopilot, Command, Frame
+from .discretise import waypoint_s
+from .flight_path import TAKEOFF_CLIMB_DEG, climb_distance_m, plan_flight_path
+from .model import FlightPath, Home, Mission, MissionItem, waypoint
+
+#: Default largest distance between the exact path and the waypoint polyline, in rho.
+DEFAULT_TOLERANCE_RHO = 0.02
+#: The discretiser first tries this fraction of the tolerance, and coarsens only to fit.
+PREFERRED_TOLERANCE_FRACTION = 0.25
+#: Mission slots a vehicle holds by default: ArduPilot boards without mission storage on SD
+#: card hold about 700 (home included); PX4's default dataman holds 500.
+DEFAULT_MAX_ITEMS = {"ardupilot": 700, "px4": 500}
+RETURN_MODES = ("rtl", "land", "none")
+
+
+@dataclass(frozen=True)
+class MissionSettings:
+    """How to turn a tour into a mission.  ``None`` means the default stated in each note."""
+
+    autopilot: str = "ardupilot"
+    altitude_m: float = 100.0              # cruise altitude above home
+    airspeed_m_s: float | None = None
+    home_deg: tuple[float, float] | None = None       # (lat, lon); default the mission centre
+    home_altitude_amsl_m: float = 0.0
+    launch_bearing_deg: float | None = None   # compass; default towards the first target
+    landing_bearing_deg: float | None = None  # compass; default the launch bearing
+    return_mode: str | None = None            # rtl | land | none; default rtl (ArduPilot), land (PX4)
+    tolerance_m: float | None = None          # default DEFAULT_TOLERANCE_RHO * rho
+    max_items: int | None = None              # default DEFAULT_MAX_ITEMS[autopilot]
+    target_acceptance_m: float = 5.0          # acceptance radius of target waypoints
+    takeoff_pitch_deg: float = TAKEOFF_CLIMB_DEG
+
+    def checked(self, rho_m: float) -> "MissionSettings":
+        """The settings with defaults filled in, or :class:`InputError` saying what is wrong."""
+        if self.autopilot not in AUTOPILOTS:
+            raise InputError(f"unknown autopilot {self.autopilot!r}; choose ardupilot or px4")
+        if not (math.isfinite(self.altitude_m) and self.altitude_m > 0):
+            raise InputError(f"altitude must be a number above 0 m (above home), got "
+                             f"{self.altitude_m!r}")
+        if self.airspeed_m_s is not None and not (math.isfinite(self.airspeed_m_s)
+                                                  and self.airspeed_m_s > 0):
+            raise InputError(f"airspeed must be a number above 0 m/s, got {self.airspeed_m_s!r}")
+        return_mode = self.return_mode or ("land" if self.autopilot == "px4" else "rtl")
+        if return_mode not in RETURN_MODES:
+            raise InputError(f"unknown return {return_mode!r}; choose {', '.join(RETURN_MODES)}")
+        tolerance = DEFAULT_TOLERANCE_RHO * rho_m if self.tolerance_m is None else self.tolerance_m
+        if not (math.isfinite(tolerance) and 0 < tolerance <= rho_m):
+            raise InputError(f"the waypoint tolerance must be above 0 and at most rho "
+                             f"({rho_m:g} m), got {tolerance!r}")
+        max_items = DEFAULT_MAX_ITEMS[self.autopilot] if self.max_items is None else self.max_items
+        if max_items < 1:
+            raise InputError(f"--max-items must be at least 1, got {max_items}")
+        if not (math.isfinite(self.home_altitude_amsl_m) and abs(self.home_altitude_amsl_m) < 1e4):
+            raise InputError(f"home altitude must be a number of metres above sea level, got "
+                             f"{self.home_altitude_amsl_m!r}")
+        for name in ("launch_bearing_deg", "landing_bearing_deg"):
+            value = getattr(self, name)
+            if value is not None and not math.isfinite(value):
+                raise InputError(f"{name.replace('_deg', '').replace('_', ' ')} must be a number "
+                                 "of degrees")
+        return MissionSettings(self.autopilot, self.altitude_m, self.airspeed_m_s, self.home_deg,
+                               self.home_altitude_amsl_m, self.launch_bearing_deg,
+                               self.landing_bearing_deg, return_mode, tolerance, max_items,
+                               self.target_acceptance_m, self.takeoff_pitch_deg)
+
+
+def _fixed_items(settings: MissionSettings) -> int:
+    """Items that are not waypoints on the path (takeoff, speed, return; ArduPilot's home)."""
+    return (1 + (settings.airspeed_m_s is not None)
+            + {"rtl": 1, "land": 2, "none": 0}[settings.return_mode]
+            + (settings.autopilot == "ardupilot"))
+
+
+def _fit_waypoints(path: FlightPath, rho_m: float, settings: MissionSettings) -> tuple[np.ndarray, float]:
+    """Waypoint arc lengths at the finest tolerance in [preferred, tolerance] that fits the
+    item budget, and that tolerance."""
+    budget = settings.max_items - _fixed_items(settings) + 1   # the takeoff point is free
+    fine = PREFERRED_TOLERANCE_FRACTION * settings.tolerance_m
+    chosen = waypoint_s(path.chain, rho_m, path.target_s_m, fine)
+    if len(chosen) <= budget:
+        return chosen, fine
+    coarse = waypoint_s(path.chain, rho_m, path.target_s_m, settings.tolerance_m)
+    if len(coarse) > budget:
+        needed = len(coarse) - 1 + _fixed_items(settings)
+        raise InputError(
+            f"the mission needs {needed} items at a waypoint tolerance of "
+            f"{settings.tolerance_m:.3g} m but the vehicle holds {settings.max_items} "
+            f"(--max-items). Allow more items if the vehicle has the space (ArduPilot with the "
+            f"mission on SD card, BRD_SD_MISSION, holds about 4,300), accept a coarser "
+            f"--tolerance, or split the targets into several missions")
+    low, high, chosen = fine, settings.tolerance_m, coarse
+    for _ in range(12):
+        middle = math.sqrt(low * high)
+        attempt = waypoint_s(path.chain, rho_m, path.target_s_m, middle)
+        if len(attempt) <= budget:
+            high, chosen = middle, attempt
+        else:
+            low = middle
+    return chosen, high
+
+
+def build_mission(tour: Tour, frame: LocalFrame, targets: GeoTargets,
+                  settings: MissionSettings) -> Mission:
+    """The mission that flies ``tour`` (planned in ``frame``) from take-off to the return.
+
+    Guarantees: the waypoint polyline stays within the reported tolerance of the exact flight
+    path; every target is one NAV_WAYPOINT at its own coordinates; the item count fits
+    ``max_items`` (with ArduPilot's home slot) or :class:`InputError` says how many are needed.
+    """
+    settings = settings.checked(tour.rho_m)
+    notes: list[str] = []
+    if settings.home_deg is None:
+        home_lat, home_lon = frame.origin_lat_deg, frame.origin_lon_deg
+        notes.append(f"home (launch) not given: using the centre of the targets "
+                     f"({home_lat:.7f}, {home_lon:.7f})")
+    else:
+        home_lat, home_lon = settings.home_deg
+        frame.check_extent(home_lat, home_lon, "targets and home")
+    home_m = frame.to_local(home_lat, home_lon)[0]
+    if settings.autopilot == "px4" and settings.return_mode != "land":
+        notes.append("PX4 refuses to start a fixed-wing mission without a landing unless "
+                     "MIS_TKO_LAND_REQ allows it; consider --return land")
+    launch = (None if settings.launch_bearing_deg is None
+              else bearing_to_heading_rad(settings.launch_bearing_deg))
+    landing = (None if settings.landing_bearing_deg is None
+               else bearing_to_heading_rad(settings.landing_bearing_deg))
+    path = plan_flight_path(tour, home_m, settings.altitude_m, settings.return_mode, launch,
+                            landing, targets.altitudes_m)
+    launch_heading = path.chain.starts[0, 2]
+    if settings.launch_bearing_deg is None:
+        notes.append(f"launch bearing not given: towards the first target "
+                     f"({heading_to_bearing_deg(launch_heading):.0f} deg)")
+    chosen, tolerance = _fit_waypoints(path, tour.rho_m, settings)
+    if tolerance > PREFERRED_TOLERANCE_FRACTION * settings.tolerance_m:
+        notes.append(f"waypoints coarsened to a tolerance of {tolerance:.3g} m to fit "
+                     f"{settings.max_items} mission slots")
+    items = _items(path, chosen, frame, targets, settings, home_lat, home_lon)
+    summary = _summary(tour, path, items, settings, home_m)
+    autopilot = AUTOPILOTS[settings.autopilot]
+    mission = Mission(tuple(items), Home(home_lat, home_lon, settings.home_altitude_amsl_m),
+                      autopilot, settings.airspeed_m_s, tour.rho_m, tolerance, frame, tour, path,
+                      targets.names, tuple(notes), summary)
+    summary["vehicle_slots"] = mission.vehicle_item_count()
+    return mission
+
+
+def _items(path: FlightPath, chosen: np.ndarray, frame: LocalFrame, targets: GeoTargets,
+           settings: MissionSettings, home_lat: float, home_lon: float) -> list[MissionItem]:
+    latitudes, longitudes = frame.to_geodetic(path.chain.pose_at(chosen)[:, :2])
+    altitudes = path.altitude_m(chosen)
+    target_at = {float(s): index for index, s in enumerate(path.target_s_m)}
+    items = [MissionItem(Command.NAV_TAKEOFF, Frame.GLOBAL_RELATIVE_ALT,
+                         (float(settings.takeoff_pitch_deg), 0.0, 0.0, 0.0), float(latitudes[0]),
+                         float(longitudes[0]), float(settings.altitude_m), True, "takeoff")]
+    if settings.airspeed_m_s is not None:
+        items.append(MissionItem(Command.DO_CHANGE_SPEED, Frame.MISSION,
+                                 (0.0, float(settings.airspeed_m_s), -1.0, 0.0), role="speed"))
+    for k in range(1, len(chosen)):
+        s = float(chosen[k])
+        if s in target_at:
+            index = target_at[s]
+            items.append(waypoint(targets.latitudes_deg[index], targets.longitudes_deg[index],
+                                  altitudes[k], "target", index, settings.target_acceptance_m))
+        elif settings.return_mode == "land" and k == len(chosen) - 1:
+            items.append(waypoint(latitudes[k], longitudes[k], path.altitudes_at_s[1][-1],
+                                  "approach"))
+        else:
+            items.append(waypoint(latitudes[k], longitudes[k], altitudes[k]))
+        if settings.return_mode == "land" and s == path.tour_end_s_m:
+            items.append(MissionItem(Command.DO_LAND_START, Frame.MISSION, (0.0, 0.0, 0.0, 0.0),
+                                     role="land_start"))
+    if settings.return_mode == "rtl":
+        items.append(MissionItem(Command.NAV_RETURN_TO_LAUNCH, Frame.MISSION,
+                                 (0.0, 0.0, 0.0, 0.0), role="return"))
+    elif settings.return_mode == "land":
+        items.append(MissionItem(Command.NAV_LAND, Frame.GLOBAL_RELATIVE_ALT, (0.0, 0.0, 0.0, 0.0),
+                                 home_lat, home_lon, 0.0, True, "land"))
+    return items
+
+
+def _summary(tour: Tour, path: FlightPath, items: list[MissionItem],
+             settings: MissionSettings, home_m: np.ndarray) -> dict:
+    """Lengths and times a user wants before flying (distances in metres, times in seconds)."""
+    climb = climb_distance_m(settings.altitude_m)
+    flown = climb + path.chain.length_m
+    if settings.return_mode != "none":    # straight home (RTL) or down the approach (land)
+        flown += float(np.hypot(*(path.chain.ends()[-1, :2] - home_m)))
+    summary = {"targets": len(tour.targets_m), "tour_length_m": tour.length_m,
+               "path_length_m": path.chain.length_m, "flight_length_m": flown,
+               "items": len(items), "waypoints": sum(i.command == Command.NAV_WAYPOINT for i in items)}
+    if settings.airspeed_m_s is not None:
+        summary["flight_time_s"] = flown / settings.airspeed_m_s
+    return summary

@@ -1,0 +1,42 @@
+"""The MAVLink enumeration values the mission uses, named as in the MAVLink common dialect.
+
+Kept here (not imported from pymavlink) so the mission model stays free of the protocol
+library; a test checks every value against pymavlink's generated dialect.
+"""
+
+from __future__ import annotations
+
+from enum import IntEnum
+
+
+class Command(IntEnum):
+    """MAV_CMD values."""
+
+    NAV_WAYPOINT = 16
+    NAV_LOITER_TURNS = 18
+    NAV_RETURN_TO_LAUNCH = 20
+    NAV_LAND = 21
+    NAV_TAKEOFF = 22
+    DO_CHANGE_SPEED = 178
+    DO_LAND_START = 189
+
+
+class Frame(IntEnum):
+    """MAV_FRAME values."""
+
+    GLOBAL = 0
+    MISSION = 2
+    GLOBAL_RELATIVE_ALT = 3
+
+
+class Autopilot(IntEnum):
+    """MAV_AUTOPILOT values, as QGroundControl's ``firmwareType``."""
+
+    ARDUPILOTMEGA = 3
+    PX4 = 12
+
+
+#: MAV_TYPE_FIXED_WING, QGroundControl's ``vehicleType`` for these missions.
+VEHICLE_TYPE_FIXED_WING = 1
+
+AUTOPILOTS = {"ardupilot": Autopilot.ARDUPILOTMEGA, "px4": Autopilot.PX4}

@@ -1,0 +1,113 @@
+"""The mission: a format-independent list of MAVLink mission items and what it was made from.
+
+Exporters and uploaders read this model and nothing else.  Coordinates are exact degrees
+(float64); a format that needs integers (MISSION_ITEM_INT) rounds them with
+:func:`degrees_to_e7` -- in one place.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass, field
+from typing import Any
+
+import numpy as np
+
+from ..frame import LocalFrame
+from ..segments import SegmentChain
+from ..tour import Tour
+from .commands import Autopilot, Command, Frame
+
+
+def degrees_to_e7(degrees: float) -> int:
+    """Degrees as the int32 of MISSION_ITEM_INT (``round(deg * 1e7)``, about 1 cm)."""
+    return int(round(degrees * 1e7))
+
+
+@dataclass(frozen=True)
+class MissionItem:
+    """One mission item, as MISSION_ITEM_INT carries it, in plain units.
+
+    ``params`` are param1..param4; ``latitude_deg``/``longitude_deg`` are 0 for items without a
+    position (frame MISSION).  ``altitude_m`` is relative to home in frame GLOBAL_RELATIVE_ALT.
+    ``role`` says why the item is there (takeoff, speed, path, target, land_start, approach,
+    land, return) and ``target`` which target (input order) a ``target`` item visits.
+    """
+
+    command: int
+    frame: int
+    params: tuple[float, float, float, float]
+    latitude_deg: float = 0.0
+    longitude_deg: float = 0.0
+    altitude_m: float = 0.0
+    autocontinue: bool = True
+    role: str = "path"
+    target: int = -1
+
+    @property
+    def has_position(self) -> bool:
+        return self.frame != Frame.MISSION
+
+
+@dataclass(frozen=True)
+class Home:
+    """Launch (home) position; ``altitude_amsl_m`` is above mean sea level."""
+
+    latitude_deg: float
+    longitude_deg: float
+    altitude_amsl_m: float = 0.0
+
+
+@dataclass(frozen=True)
+class FlightPath:
+    """The exact path the mission flies, in the local frame: lead-in from the end of the
+    climb-out, the tour opened at its best cut, and the lead-out to the landing approach.
+
+    ``target_s_m[i]`` is the arc length at which target ``i`` is overflown; the tour part spans
+    ``[tour_start_s_m, tour_end_s_m]``.
+    """
+
+    chain: SegmentChain
+    target_s_m: np.ndarray
+    tour_start_s_m: float
+    tour_end_s_m: float
+    climb_start_m: np.ndarray          # home (x, y): where the takeoff begins
+    altitudes_at_s: tuple[np.ndarray, np.ndarray]   # knots (s_m, altitude_m) for np.interp
+
+    def altitude_m(self, s_m: np.ndarray) -> np.ndarray:
+        return np.interp(s_m, *self.altitudes_at_s)
+
+
+@dataclass(frozen=True)
+class Mission:
+    """Mission items with everything exporters need to describe them."""
+
+    items: tuple[MissionItem, ...]
+    home: Home
+    autopilot: Autopilot
+    cruise_speed_m_s: float | None
+    rho_m: float
+    tolerance_m: float                 # every point of the path is this close to the waypoints
+    frame: LocalFrame
+    tour: Tour
+    path: FlightPath
+    target_names: tuple[str, ...] | None = None
+    notes: tuple[str, ...] = ()        # decisions the user should know about
+    summary: dict[str, Any] = field(default_factory=dict)
+
+    @property
+    def target_items(self) -> list[int]:
+        """Index (in ``items``) of the waypoint of each target, in target order."""
+        index = {item.target: k for k, item in enumerate(self.items) if item.role == "target"}
+        return [index[t] for t in range(len(self.tour.targets_m))]
+
+    def vehicle_item_count(self) -> int:
+        """Mission slots on the vehicle: the items plus ArduPilot's home at seq 0."""
+        return len(self.items) + (1 if self.autopilot == Autopilot.ARDUPILOTMEGA else 0)
+
+
+def waypoint(latitude_deg: float, longitude_deg: float, altitude_m: float, role: str = "path",
+             target: int = -1, acceptance_m: float = 0.0) -> MissionItem:
+    """A NAV_WAYPOINT (param2: acceptance radius, 0 for the autopilot's default)."""
+    return MissionItem(Command.NAV_WAYPOINT, Frame.GLOBAL_RELATIVE_ALT,
+                       (0.0, float(acceptance_m), 0.0, 0.0), float(latitude_deg),
+                       float(longitude_deg), float(altitude_m), True, role, target)

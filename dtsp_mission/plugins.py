@@ -1,0 +1,35 @@
+"""Loading plugins from entry-point groups: one mechanism for built-ins and third parties.
+
+A plugin that fails to import, or is not what its group expects, is reported (logged, and
+returned as the error) and skipped; it never breaks the rest.
+"""
+
+from __future__ import annotations
+
+import logging
+from importlib.metadata import entry_points
+from typing import Callable
+
+log = logging.getLogger(__name__)
+
+
+def load_group(group: str, accepts: Callable[[object], bool],
+               expected: str) -> dict[str, object | Exception]:
+    """Every entry point of ``group`` by name, loaded; a broken one maps to its error.
+
+    ``accepts`` says whether a loaded object is a valid plugin of the group; ``expected`` names
+    what it should be, for the error message.
+    """
+    found: dict[str, object | Exception] = {}
+    for entry_point in sorted(entry_points(group=group), key=lambda e: e.name):
+        if entry_point.name in found:
+            continue
+        try:
+            loaded = entry_point.load()
+            if not accepts(loaded):
+                raise TypeError(f"{entry_point.value} is not {expected}")
+            found[entry_point.name] = loaded
+        except Exception as error:  # a broken plugin must not break the program
+            log.warning("%s plugin %r is broken: %r", group, entry_point.name, error)
+            found[entry_point.name] = error
+    return found

@@ -1,0 +1,108 @@
+"""Targets and survey area from GeoJSON (RFC 7946).
+
+Point and MultiPoint features are targets (``[longitude, latitude]``; a third coordinate is
+ignored because GeoJSON does not say what it is relative to -- use the ``alt`` property, metres
+above home).  A ``name`` property names a target.  One Polygon feature, if present, is the
+survey area.  Any other geometry is an error.
+"""
+
+from __future__ import annotations
+
+import json
+import os
+from typing import Any
+
+import numpy as np
+import shapely
+from shapely.geometry import shape
+from shapely.validation import explain_validity
+
+from ..errors import FileFormatError
+from ..files import read_text
+from ..frame import check_geodetic
+from .model import GeoTargets, check_altitudes, geodetic_targets
+
+
+def _features(data: Any, path) -> list[dict]:
+    if not isinstance(data, dict) or "type" not in data:
+        raise FileFormatError(f"{path}: not GeoJSON (expected an object with a 'type')")
+    if data["type"] == "FeatureCollection":
+        features = data.get("features")
+        if not isinstance(features, list):
+            raise FileFormatError(f"{path}: a FeatureCollection needs a 'features' list")
+        return features
+    if data["type"] == "Feature":
+        return [data]
+    return [{"type": "Feature", "geometry": data, "properties": {}}]
+
+
+def area_from_geometry(geometry: dict, where: str) -> np.ndarray:
+    """The outer ring of a GeoJSON Polygon as (k, 2) rows of (latitude, longitude), checked to be
+    a valid (non self-intersecting, non-empty) polygon."""
+    try:
+        polygon = shape(geometry)
+    except (ValueError, TypeError, KeyError, IndexError, shapely.errors.GEOSException) as error:
+        raise FileFormatError(f"{where}: not a valid Polygon ({error})") from None
+    if not polygon.is_empty and not polygon.is_valid:
+        raise FileFormatError(f"{where}: the survey polygon is not valid "
+                              f"({explain_validity(polygon)})")
+    if polygon.is_empty or polygon.area <= 0.0:
+        raise FileFormatError(f"{where}: the survey polygon is empty")
+    ring = np.asarray(polygon.exterior.coords)[:, :2]
+    check_geodetic(ring[:, 1], ring[:, 0], f"{where}: vertex")
+    return ring[:, ::-1].copy()
+
+
+def read_geojson(path: str | os.PathLike) -> GeoTargets:
+    """Targets (possibly none, if the file only holds a survey area) and the survey area."""
+    text = read_text(path)
+    try:
+        data = json.loads(text)
+    except json.JSONDecodeError as error:
+        raise FileFormatError(f"{path}: not valid JSON ({error.msg} at line {error.lineno})") from None
+    latitudes: list[float] = []
+    longitudes: list[float] = []
+    names: list[str] = []
+    altitudes: list[float] = []
+    area = None
+    for number, feature in enumerate(_features(data, path), start=1):
+        where = f"{path}, feature {number}"
+        geometry = feature.get("geometry") if isinstance(feature, dict) else None
+        if not isinstance(geometry, dict):
+            raise FileFormatError(f"{where}: has no geometry")
+        properties = feature.get("properties") or {}
+        kind = geometry.get("type")
+        if kind == "Polygon":
+            if area is not None:
+                raise FileFormatError(f"{where}: a second Polygon; give one survey area")
+            area = area_from_geometry(geometry, where)
+            continue
+        if kind not in ("Point", "MultiPoint"):
+            raise FileFormatError(f"{where}: {kind!r} geometry is not supported (Point and "
+                                  "MultiPoint are targets, one Polygon is the survey area)")
+        points = [geometry.get("coordinates")] if kind == "Point" else geometry.get("coordinates")
+        for point in points if isinstance(points, list) else [None]:
+            if (not isinstance(point, list) or len(point) < 2
+                    or not all(isinstance(c, (int, float)) for c in point[:2])):
+                raise FileFormatError(f"{where}: coordinates must be [longitude, latitude], "
+                                      f"got {point!r}")
+            longitudes.append(float(point[0]))
+            latitudes.append(float(point[1]))
+            names.append(str(properties.get("name", "")))
+            altitude = properties.get("alt")
+            altitudes.append(np.nan if altitude is None else altitude)
+    if not latitudes and area is None:
+        raise FileFormatError(f"{path}: no Point features (targets) and no Polygon (area)")
+    check_geodetic(latitudes, longitudes, f"{path}: target")
+    given = [a for a in altitudes if not (isinstance(a, float) and np.isnan(a))]
+    altitude_array = None
+    if given:
+        if len(given) != len(altitudes):
+            raise FileFormatError(f"{path}: give the 'alt' property on every target or on none")
+        try:
+            altitude_array = np.array(altitudes, dtype=float)
+        except (TypeError, ValueError):
+            raise FileFormatError(f"{path}: every 'alt' property must be a number") from None
+        check_altitudes(altitude_array, str(path))
+    name_tuple = tuple(names) if any(names) else None
+    return geodetic_targets(latitudes, longitudes, name_tuple, altitude_array, area)

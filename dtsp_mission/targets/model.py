@@ -1,0 +1,107 @@
+"""Target sets in the local frame and in WGS84 degrees."""
+
+from __future__ import annotations
+
+from dataclasses import dataclass, replace
+from typing import TYPE_CHECKING
+
+import numpy as np
+
+from ..errors import InputError
+
+if TYPE_CHECKING:
+    from ..frame import LocalFrame
+
+
+@dataclass(frozen=True)
+class Targets:
+    """Target positions (n, 2) in a local frame (x east, y north, metres).
+
+    ``altitudes_m`` (optional) is the altitude above home at which each target is overflown.
+    """
+
+    positions_m: np.ndarray
+    names: tuple[str, ...] | None = None
+    merged_duplicates: int = 0      # how many repeated positions were dropped
+    altitudes_m: np.ndarray | None = None
+
+    def __len__(self) -> int:
+        return len(self.positions_m)
+
+    def to_geodetic(self, frame: "LocalFrame") -> "GeoTargets":
+        """The same targets in degrees, through ``frame``."""
+        latitudes, longitudes = frame.to_geodetic(self.positions_m)
+        return GeoTargets(latitudes, longitudes, self.names, self.merged_duplicates,
+                          self.altitudes_m)
+
+
+@dataclass(frozen=True)
+class GeoTargets:
+    """Targets in WGS84 degrees, with an optional survey area.
+
+    ``area_deg`` is the outer ring of the survey polygon as (k, 2) rows of (latitude, longitude)
+    or None.  ``altitudes_m`` as in :class:`Targets`.
+    """
+
+    latitudes_deg: np.ndarray
+    longitudes_deg: np.ndarray
+    names: tuple[str, ...] | None = None
+    merged_duplicates: int = 0
+    altitudes_m: np.ndarray | None = None
+    area_deg: np.ndarray | None = None
+
+    def __len__(self) -> int:
+        return len(self.latitudes_deg)
+
+    def in_frame(self, frame: "LocalFrame") -> Targets:
+        """The same targets in the local frame (after checking they fit in it)."""
+        frame.check_extent(self.latitudes_deg, self.longitudes_deg)
+        return Targets(frame.to_local(self.latitudes_deg, self.longitudes_deg), self.names,
+                       self.merged_duplicates, self.altitudes_m)
+
+    def with_area(self, area_deg: np.ndarray | None) -> "GeoTargets":
+        return replace(self, area_deg=area_deg)
+
+
+def check_altitudes(altitudes_m: np.ndarray | None, where: str) -> None:
+    """Raise :class:`InputError` unless every altitude is a finite number above zero."""
+    if altitudes_m is None:
+        return
+    bad = ~np.isfinite(altitudes_m) | (altitudes_m <= 0.0)
+    if bad.any():
+        index = int(np.argmax(bad))
+        raise InputError(f"{where}, target {index + 1}: altitude {float(altitudes_m[index])!r} m must be "
+                         "a number above 0 (metres above home)")
+
+
+def merge_duplicates(positions: np.ndarray) -> tuple[np.ndarray, int]:
+    """Indices (in input order) of the first target at each distinct position, and how many
+    were dropped.  ``positions`` is any (n, 2) coordinate array; equality is exact."""
+    _, first = np.unique(np.asarray(positions, dtype=float), axis=0, return_index=True)
+    keep = np.sort(first)
+    return keep, len(positions) - len(keep)
+
+
+def _pick(values, keep):
+    if values is None:
+        return None
+    if isinstance(values, tuple):
+        return tuple(values[i] for i in keep)
+    return np.asarray(values)[keep]
+
+
+def local_targets(positions_m: np.ndarray, names=None, altitudes_m=None) -> Targets:
+    """:class:`Targets` with exact duplicates merged (the first one kept)."""
+    keep, merged = merge_duplicates(positions_m)
+    return Targets(np.asarray(positions_m, dtype=float)[keep], _pick(names, keep), merged,
+                   _pick(altitudes_m, keep))
+
+
+def geodetic_targets(latitudes_deg: np.ndarray, longitudes_deg: np.ndarray, names=None,
+                     altitudes_m=None, area_deg=None) -> GeoTargets:
+    """:class:`GeoTargets` with exact duplicates merged (the first one kept)."""
+    latitudes = np.asarray(latitudes_deg, dtype=float)
+    longitudes = np.asarray(longitudes_deg, dtype=float)
+    keep, merged = merge_duplicates(np.column_stack([latitudes, longitudes]))
+    return GeoTargets(latitudes[keep], longitudes[keep], _pick(names, keep), merged,
+                      _pick(altitudes_m, keep), area_deg)

@@ -1,0 +1,22 @@
+"""Choosing the reader from the file name."""
+
+from __future__ import annotations
+
+import os
+from pathlib import Path
+
+from ..errors import FileFormatError
+from .csv_file import read_csv
+from .geojson_file import read_geojson
+from .model import GeoTargets, Targets
+
+READERS = {".csv": read_csv, ".txt": read_csv, ".geojson": read_geojson, ".json": read_geojson}
+
+
+def read_targets(path: str | os.PathLike) -> GeoTargets | Targets:
+    """Targets from a CSV (``.csv``/``.txt``) or GeoJSON (``.geojson``/``.json``) file."""
+    suffix = Path(path).suffix.lower()
+    if suffix not in READERS:
+        raise FileFormatError(f"{path}: cannot tell the format from {suffix or 'no extension'!r}; "
+                              "targets are read from .csv or .geojson files")
+    return READERS[suffix](path)

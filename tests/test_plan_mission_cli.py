@@ -1,0 +1,101 @@
+"""``dtsp-mission plan`` from geodetic inputs to mission files, end to end."""
+
+import json
+import subprocess
+import sys
+from pathlib import Path
+
+import numpy as np
+import pytest
+from pymavlink import mavwp
+
+from conftest import assert_valid_tour
+from dtsp_mission.export.qgc_plan import plan_rule_violations
+from dtsp_mission.tour import read_tour
+
+EXAMPLES = Path(__file__).parents[1] / "examples"
+SITE = EXAMPLES / "site-inspection.csv"
+AREA = EXAMPLES / "survey-area.geojson"
+
+
+def run(*arguments):
+    return subprocess.run([sys.executable, "-m", "dtsp_mission.cli", "plan", *map(str, arguments)],
+                          capture_output=True, text=True, timeout=300)
+
+
+def test_site_example_to_every_format_and_a_plot(tmp_path):
+    outputs = [tmp_path / name for name in ("m.plan", "m.waypoints", "m.geojson", "m.json")]
+    arguments = [SITE, "--radius", "80", "--alt", "120", "--airspeed", "22", "--max-items", "4000",
+                 "--plot", tmp_path / "m.png"]
+    for output in outputs:
+        arguments += ["-o", output]
+    result = run(*arguments)
+    assert result.returncode == 0, result.stderr
+    assert "272 targets" in result.stdout and "mission (ArduPilot)" in result.stdout
+    assert "min at 22 m/s" in result.stdout and "home (launch) not given" in result.stderr
+    plan = json.loads(outputs[0].read_text())
+    assert plan_rule_violations(plan) == []
+    items = plan["mission"]["items"]
+    assert items[0]["command"] == 22 and items[-1]["command"] == 20
+    loader = mavwp.MAVWPLoader()
+    assert loader.load(str(outputs[1])) == len(items) + 1
+    assert len([f for f in json.loads(outputs[2].read_text())["features"]
+                if f["properties"]["kind"] == "target"]) == 272
+    assert_valid_tour(read_tour(outputs[3]))
+    assert (tmp_path / "m.png").read_bytes()[:8] == b"\x89PNG\r\n\x1a\n"
+    # The names and altitudes from the CSV reach the files.
+    targets = [f["properties"] for f in json.loads(outputs[2].read_text())["features"]
+               if f["properties"]["kind"] == "target"]
+    assert {t["name"] for t in targets} >= {"line1-pylon01", "tank1-01", "fence-01"}
+    assert {t["altitude_m"] for t in targets} == {90.0, 70.0, 60.0}
+
+
+def test_default_budget_refuses_with_the_count_and_a_coarser_tolerance_fits(tmp_path):
+    result = run(SITE, "--radius", "80", "-o", tmp_path / "m.plan")
+    assert result.returncode == 2 and "items at a waypoint tolerance" in result.stderr
+    assert not (tmp_path / "m.plan").exists()
+    result = run(SITE, "--radius", "80", "--tolerance", "8", "-o", tmp_path / "m.plan")
+    assert result.returncode == 0, result.stderr
+    assert len(json.loads((tmp_path / "m.plan").read_text())["mission"]["items"]) + 1 <= 700
+
+
+def test_random_targets_in_a_polygon_are_seeded(tmp_path):
+    first, second, other = (tmp_path / f"{n}.waypoints" for n in ("a", "b", "c"))
+    common = ["--random", "60", "--area", AREA, "--airspeed", "20", "--max-bank", "30",
+              "--autopilot", "px4", "--max-items", "3000"]
+    assert run(*common, "--seed", "4", "-o", first).returncode == 0
+    assert run(*common, "--seed", "4", "-o", second).returncode == 0
+    result = run(*common, "--seed", "5", "-o", other)
+    assert result.returncode == 0, result.stderr
+    assert "rho 70.6 m from airspeed 20 m/s and 30 deg bank" in result.stdout
+    assert first.read_text() == second.read_text() != other.read_text()
+    assert "\t21\t" in first.read_text().splitlines()[-1]      # PX4 default: a landing
+
+
+def test_geojson_targets_and_local_csv_with_origin(tmp_path):
+    features = [{"type": "Feature", "properties": {"name": f"p{i}", "alt": 80 + i},
+                 "geometry": {"type": "Point", "coordinates": [6.95 + 0.004 * i, 46.8 + 0.003 * (i % 3)]}}
+                for i in range(8)]
+    source = tmp_path / "t.geojson"
+    source.write_text(json.dumps({"type": "FeatureCollection", "features": features}))
+    result = run(source, "--radius", "60", "--return", "land", "--max-items", "2000",
+                 "-o", tmp_path / "g.plan")
+    assert result.returncode == 0, result.stderr
+    items = json.loads((tmp_path / "g.plan").read_text())["mission"]["items"]
+    assert [i["command"] for i in items].count(189) == 1 and items[-1]["command"] == 21
+    local = tmp_path / "local.csv"
+    local.write_text("x,y,name\n0,0,a\n800,100,b\n400,900,c\n-300,500,d\n")
+    result = run(local, "--radius", "60", "--origin", "46.8,6.95", "--max-items", "2000",
+                 "-o", tmp_path / "l.geojson")
+    assert result.returncode == 0, result.stderr
+    names = {f["properties"].get("name") for f in json.loads((tmp_path / "l.geojson").read_text())["features"]}
+    assert {"a", "b", "c", "d"} <= names
+
+
+def test_vehicle_options_must_be_complete(tmp_path):
+    result = run(SITE, "--max-bank", "30", "-o", tmp_path / "m.json")
+    assert result.returncode == 2 and "--max-bank needs --airspeed" in result.stderr
+    result = run(SITE, "-o", tmp_path / "m.json")
+    assert result.returncode == 2 and "give the turn radius" in result.stderr
+    result = run(SITE, "--radius", "80", "--airspeed", "20", "--max-bank", "30")
+    assert result.returncode == 2 and "not both" in result.stderr

@@ -1,0 +1,92 @@
+"""Target readers: CSV (degrees or metres) and GeoJSON, random targets in a polygon."""
+
+import json
+
+import numpy as np
+import pytest
+import shapely
+
+from dtsp_mission.errors import FileFormatError, InputError
+from dtsp_mission.frame import LocalFrame
+from dtsp_mission.targets import GeoTargets, Targets, random_targets, read_targets
+
+
+def write(tmp_path, name, content):
+    path = tmp_path / name
+    path.write_text(content if isinstance(content, str) else json.dumps(content))
+    return path
+
+
+def test_csv_in_degrees_with_alt_and_names_and_a_duplicate(tmp_path):
+    path = write(tmp_path, "t.csv", " Latitude , LON ,alt,Name\n46.8,6.9,50,a\n46.81,6.91,60,b\n"
+                                    "46.8,6.9,70,c\n")
+    targets = read_targets(path)
+    assert isinstance(targets, GeoTargets) and len(targets) == 2
+    assert targets.names == ("a", "b") and targets.merged_duplicates == 1
+    assert list(targets.altitudes_m) == [50.0, 60.0]
+
+
+def test_csv_in_metres(tmp_path):
+    targets = read_targets(write(tmp_path, "t.csv", "x_m,y_m\n0,0\n10,5\n"))
+    assert isinstance(targets, Targets) and targets.positions_m.tolist() == [[0, 0], [10, 5]]
+
+
+@pytest.mark.parametrize("content, message", [
+    ("lat,lon,x,y\n1,2,3,4\n", "either columns lat and lon"),
+    ("lat,lat,lon\n1,2,3\n", "given twice"),
+    ("lat,lon\n1,2,3\n", "3 fields where the header has 2"),
+    ("lat,lon,alt\n46,7,0\n", "must be a number above 0"),
+])
+def test_csv_errors(tmp_path, content, message):
+    with pytest.raises((FileFormatError, InputError), match=message):
+        read_targets(write(tmp_path, "t.csv", content))
+
+
+def polygon(ring):
+    return {"type": "Feature", "properties": {}, "geometry": {"type": "Polygon", "coordinates": [ring]}}
+
+
+SQUARE = [[6.9, 46.8], [6.96, 46.8], [6.96, 46.84], [6.9, 46.84], [6.9, 46.8]]
+
+
+def test_geojson_points_multipoint_and_area(tmp_path):
+    data = {"type": "FeatureCollection", "features": [
+        {"type": "Feature", "properties": {"name": "a"}, "geometry": {"type": "Point", "coordinates": [6.91, 46.81, 400]}},
+        {"type": "Feature", "properties": None, "geometry": {"type": "MultiPoint", "coordinates": [[6.92, 46.82], [6.93, 46.83]]}},
+        polygon(SQUARE)]}
+    targets = read_targets(write(tmp_path, "t.geojson", data))
+    assert len(targets) == 3 and targets.names == ("a", "", "")
+    assert targets.area_deg.shape == (5, 2) and targets.area_deg[1].tolist() == [46.8, 6.96]
+
+
+@pytest.mark.parametrize("data, message", [
+    (polygon([[6.9, 46.8], [6.96, 46.84], [6.96, 46.8], [6.9, 46.84], [6.9, 46.8]]), "not valid"),
+    ({"type": "FeatureCollection", "features": [polygon(SQUARE), polygon(SQUARE)]}, "second Polygon"),
+    ({"type": "Point", "coordinates": [6.9]}, "coordinates must be"),
+    ({"type": "FeatureCollection", "features": [
+        {"type": "Feature", "properties": {"alt": 50}, "geometry": {"type": "Point", "coordinates": [6.9, 46.8]}},
+        {"type": "Feature", "properties": {}, "geometry": {"type": "Point", "coordinates": [6.91, 46.8]}}]},
+     "on every target or on none"),
+    ({"type": "Point", "coordinates": [6.9, 95]}, "latitude 95.0"),
+    ([1, 2], "not GeoJSON"),
+])
+def test_geojson_errors(tmp_path, data, message):
+    with pytest.raises((FileFormatError, InputError), match=message):
+        read_targets(write(tmp_path, "t.geojson", data))
+
+
+def test_random_targets_are_inside_uniform_and_seeded():
+    area = np.array(SQUARE)[:, ::-1]
+    first = random_targets(area, 4000, seed=1)
+    again = random_targets(area, 4000, seed=1)
+    assert np.array_equal(first.latitudes_deg, again.latitudes_deg)
+    assert not np.array_equal(first.latitudes_deg, random_targets(area, 4000, seed=2).latitudes_deg)
+    frame = LocalFrame(46.82, 6.93)
+    local = frame.to_local(first.latitudes_deg, first.longitudes_deg)
+    outline = shapely.Polygon(frame.to_local(area[:, 0], area[:, 1]))
+    assert shapely.contains_xy(outline, local[:, 0], local[:, 1]).all()
+    # Uniform: the west half of the square holds about half the points.
+    west = (first.longitudes_deg < 6.93).mean()
+    assert abs(west - 0.5) < 0.03
+    with pytest.raises(InputError):
+        random_targets(area, 0, seed=1)
