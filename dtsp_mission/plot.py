@@ -21,15 +21,21 @@ from .mission.discretise import candidate_s
 from .tour import Tour
 
 
+def require_matplotlib() -> None:
+    """Raise :class:`InputError` now, before any work, if matplotlib is missing."""
+    try:
+        import matplotlib  # noqa: F401
+    except ImportError:
+        raise InputError("--plot needs matplotlib: pip install 'dtsp-mission[plot]'") from None
+
+
 def draw_plan(product: Mission | Tour, path: str | os.PathLike,
               area_m: np.ndarray | None = None, title: str = "") -> Path:
     """Write a PNG of ``product`` to ``path`` (atomically)."""
-    try:
-        import matplotlib
-        matplotlib.use("Agg")
-        import matplotlib.pyplot as plt
-    except ImportError:
-        raise InputError("--plot needs matplotlib: pip install 'dtsp-mission[plot]'") from None
+    require_matplotlib()
+    import matplotlib
+    matplotlib.use("Agg")
+    import matplotlib.pyplot as plt
     mission = product if isinstance(product, Mission) else None
     tour = mission.tour if mission else product
     chain = mission.path.chain if mission else tour.chain

@@ -13,6 +13,7 @@ from ..frame import LocalFrame
 from ..mission import Autopilot, MissionSettings, build_mission
 from ..planning import TilingUnavailable, get_planner, planners
 from ..planning.lower_bounds import lower_bound
+from ..plot import draw_plan, require_matplotlib
 from ..targets import GeoTargets, Targets, random_targets, read_targets
 from ..targets.geojson_file import read_geojson
 from .options import (LAT_LON, UserError, apply, reports_errors, seed_option, turn_radius_from,
@@ -126,6 +127,8 @@ def plan(targets_file, random_count, area_file, seed, origin, rho_m, airspeed_m_
     Example: dtsp-mission plan examples/site-inspection.csv --radius 80 --alt 120 -o mission.plan
     """
     writers = [(output, exporter_for(output, format_name)) for output in outputs]
+    if plot_file:
+        require_matplotlib()
     rho, rho_source = turn_radius_from(rho_m, airspeed_m_s, max_bank_deg)
     targets = _targets(targets_file, random_count, area_file, seed)
     if len(targets) < 2:
@@ -174,7 +177,6 @@ def plan(targets_file, random_count, area_file, seed, origin, rho_m, airspeed_m_
         writer.write(product, output)
         click.echo(f"wrote {output} ({writer.description})")
     if plot_file:
-        from ..plot import draw_plan
         draw_plan(product, plot_file, area_m)
         click.echo(f"wrote {plot_file} (plot)")
 

@@ -7,14 +7,16 @@ import numpy as np
 from ..tour import Tour
 from .alternating import AlternatingPlanner
 from .base import Planner
+from .headings import HeadingsPlanner
 from .rbta import RBTAPlanner
 from .region import Region
 from .tiling import TilingUnavailable
 
 
 class AutoPlanner(Planner):
-    """The shortest of the RBTA (when the targets are numerous enough to tile) and the
-    Alternating Algorithm; ``report["candidates"]`` lists every length measured."""
+    """The shortest of the RBTA (when the targets are numerous enough to tile), the Alternating
+    Algorithm and the heading-optimised Euclidean tour; ``report["candidates"]`` lists every
+    length measured."""
 
     name = "auto"
     description = "shortest checked tour of the applicable planners (default)"
@@ -22,7 +24,7 @@ class AutoPlanner(Planner):
     def _plan(self, targets_m: np.ndarray, rho_m: float, region: Region | None) -> Tour:
         candidates: dict[str, float | str] = {}
         best: Tour | None = None
-        for planner in (AlternatingPlanner(), RBTAPlanner(**self.parameters)):
+        for planner in (AlternatingPlanner(), HeadingsPlanner(), RBTAPlanner(**self.parameters)):
             try:
                 tour = planner.plan(targets_m, rho_m, region)
             except TilingUnavailable as error:
