@@ -4,7 +4,7 @@ from __future__ import annotations
 
 import click
 
-from .options import reports_errors, seed_option
+from .options import UserError, reports_errors, seed_option
 
 
 @click.group()
@@ -30,3 +30,72 @@ def dubins_bench(pairs: int, ompl_pairs: int, rho_m: float, half_width_m: float,
     from ..bench import dubins_throughput
     rows, difference = dubins_throughput.run(pairs, ompl_pairs, rho_m, half_width_m, repeats, seed)
     click.echo(dubins_throughput.report(rows, difference))
+
+
+def _sizes(ctx, param, value: str) -> list[int]:
+    try:
+        sizes = [int(part) for part in value.split(",") if part.strip()]
+    except ValueError:
+        raise click.BadParameter(f"{value!r} is not a comma-separated list of integers") from None
+    if not sizes or min(sizes) < 1:
+        raise click.BadParameter("sizes must be positive integers")
+    return sizes
+
+
+@bench.command("planners")
+@click.option("--sizes", default="50,200,1000,5000,20000,100000", show_default=True,
+              callback=_sizes, help="Numbers of targets, comma separated.")
+@click.option("--seeds", type=click.IntRange(1), default=3, show_default=True,
+              help="Instances (seeds 0..N-1) per size.")
+@click.option("--radius", "rho_m", type=float, default=100.0, show_default=True,
+              help="Turn radius in metres.")
+@click.option("--side", "side_m", type=float, default=5000.0, show_default=True,
+              help="Side of the square the targets are uniform in, metres.")
+@click.option("--planners", "names", default=None,
+              help="Planners to compare, comma separated (default: every installed one).")
+@click.option("--csv", "csv_file", type=click.Path(dir_okay=False), help="Write every run as CSV.")
+@click.option("--json", "json_file", type=click.Path(dir_okay=False), help="Write every run as JSON.")
+@click.option("--markdown", "markdown_file", type=click.Path(dir_okay=False),
+              help="Write the summary table as Markdown (for docs/benchmarks.md).")
+@click.option("--plot", "plot_file", type=click.Path(dir_okay=False),
+              help="Log-log PNG of length against n, with the lower bound.")
+@reports_errors
+def planners_bench(sizes, seeds, rho_m, side_m, names, csv_file, json_file, markdown_file,
+                   plot_file) -> None:
+    """Every planner on seeded uniform instances: length, ratio to the lower bound and to the
+    best of the run, time, peak memory, checker verdict (medians over seeds)."""
+    import sys
+
+    from ..bench import planners as planner_bench
+    from ..files import write_atomic
+    from ..planning import planners
+    from ..plot import require_matplotlib
+    if plot_file:
+        require_matplotlib()
+    installed = [n for n, p in planners().items() if not isinstance(p, Exception)]
+    chosen = installed if names is None else [n.strip() for n in names.split(",") if n.strip()]
+    unknown = sorted(set(chosen) - set(installed))
+    if unknown:
+        raise UserError(f"unknown planner(s) {', '.join(unknown)} (installed: {', '.join(installed)})")
+    steps = len(sizes) * seeds * len(chosen)
+    with click.progressbar(length=steps, label="planning", file=sys.stderr,
+                           item_show_func=lambda step: step) as bar:
+        def progress(step: str) -> None:
+            bar.update(1, step)
+        runs = planner_bench.run(sizes, seeds, rho_m, side_m, chosen, progress)
+    click.echo(f"uniform targets in a {side_m:g} m square, rho {rho_m:g} m, {seeds} seeds; "
+               "medians over seeds")
+    click.echo(planner_bench.table(runs))
+    for r in runs:
+        if not r.valid:
+            verdict = "not applicable" if r.not_applicable else "FAILED"
+            click.echo(f"{verdict}: n={r.n} seed={r.seed} {r.planner}: {r.error or 'checker'}")
+    command = "dtsp-mission bench planners " + " ".join(sys.argv[3:]) if len(sys.argv) > 3 else \
+        "dtsp-mission bench planners"
+    for path, content in ((csv_file, lambda: planner_bench.as_csv(runs)),
+                          (json_file, lambda: planner_bench.as_json(runs)),
+                          (markdown_file, lambda: planner_bench.markdown(runs, command, side_m, rho_m)),
+                          (plot_file, lambda: planner_bench.plot_png(runs, side_m, rho_m))):
+        if path:
+            write_atomic(path, content())
+            click.echo(f"wrote {path}")
