@@ -187,8 +187,10 @@ def _report_tour(tour, positions: np.ndarray, area_m: np.ndarray | None, elapsed
     else:
         area = max(float(np.ptp(positions[:, 0]) * np.ptp(positions[:, 1])), 1.0)
     bound = lower_bound(positions, tour.rho_m, area)
-    click.echo(f"planner {tour.planner}: tour {tour.length_m:,.1f} m ({elapsed:.2f} s); lower "
-               f"bound {bound.value_m:,.1f} m [{bound.kind}], ratio {tour.length_m / bound.value_m:.3f}")
+    click.echo(f"planner {tour.planner}: tour {tour.length_m:,.1f} m ({elapsed:.2f} s)")
+    click.echo(f"  certified lower bound (1-tree) {bound.one_tree_m:,.1f} m: ratio "
+               f"{tour.length_m / bound.one_tree_m:.3f}; estimate for uniform targets "
+               f"{bound.stochastic_m:,.1f} m: ratio {tour.length_m / bound.stochastic_m:.3f}")
     for phase in tour.report.get("phases", []):
         click.echo(f"  phase {phase['phase']}: meta-beads of {phase['meta_bead_beads'][0]}x"
                    f"{phase['meta_bead_beads'][1]} beads, {phase['serviced']} targets, "
