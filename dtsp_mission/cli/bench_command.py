@@ -7,6 +7,10 @@ import click
 from .options import UserError, reports_errors, seed_option
 
 
+bench_radius_option = click.option("--radius", "rho_m", type=float, default=100.0,
+                                   show_default=True, help="Turn radius in metres.")
+
+
 @click.group()
 def bench() -> None:
     """Measure speed and memory; results are printed as tables."""
@@ -17,8 +21,7 @@ def bench() -> None:
               help="Random pose pairs for the batch kernel.")
 @click.option("--ompl-pairs", type=click.IntRange(1), default=200_000, show_default=True,
               help="How many of them OMPL computes, one Python call each.")
-@click.option("--radius", "rho_m", type=float, default=100.0, show_default=True,
-              help="Turn radius in metres.")
+@bench_radius_option
 @click.option("--half-width", "half_width_m", type=float, default=1000.0, show_default=True,
               help="Positions are uniform in a square of side twice this, in metres.")
 @click.option("--repeats", type=click.IntRange(1), default=5, show_default=True)
@@ -47,8 +50,7 @@ def _sizes(ctx, param, value: str) -> list[int]:
               callback=_sizes, help="Numbers of targets, comma separated.")
 @click.option("--seeds", type=click.IntRange(1), default=3, show_default=True,
               help="Instances (seeds 0..N-1) per size.")
-@click.option("--radius", "rho_m", type=float, default=100.0, show_default=True,
-              help="Turn radius in metres.")
+@bench_radius_option
 @click.option("--side", "side_m", type=float, default=5000.0, show_default=True,
               help="Side of the square the targets are uniform in, metres.")
 @click.option("--planners", "names", default=None,

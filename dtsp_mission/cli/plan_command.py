@@ -9,7 +9,7 @@ import numpy as np
 import shapely
 
 from ..export import exporter_for
-from ..frame import LocalFrame
+from ..frame import LocalFrame, mission_centre
 from ..mission import Autopilot, MissionSettings, build_mission
 from ..planning import TilingUnavailable, get_planner, planners
 from ..planning.lower_bounds import lower_bound
@@ -53,7 +53,8 @@ def _frame(targets: GeoTargets | Targets, origin) -> tuple[Targets, GeoTargets |
     if isinstance(targets, GeoTargets):
         if origin is not None:
             raise UserError("--origin is for targets in local x/y metres; these are in lat/lon")
-        frame = LocalFrame.around(targets.latitudes_deg, targets.longitudes_deg)
+        # The readers checked the coordinates; in_frame checks that they fit the frame.
+        frame = LocalFrame(*mission_centre(targets.latitudes_deg, targets.longitudes_deg))
         return targets.in_frame(frame), targets, frame
     if origin is None:
         return targets, None, None

@@ -4,8 +4,9 @@ and pymavlink's ``MAVWPLoader``.
 Line 1 is ``QGC WPL 110``; then one line per item with exactly 12 tab-separated fields:
 ``INDEX CURRENT FRAME COMMAND P1 P2 P3 P4 LAT LON ALT AUTOCONTINUE``.  Line 0 (index 0) is
 home (frame GLOBAL, altitude above mean sea level), as all these readers expect; the mission
-items follow from index 1.  Latitudes and longitudes carry 10 decimals (about 0.01 mm), other
-numbers 6.
+items follow from index 1.  Latitudes and longitudes are written in the shortest decimal that
+reads back as the same double (a reader rounding to MISSION_ITEM_INT's 1e-7 degrees gets what
+we would send); other numbers carry 6 decimals.
 """
 
 from __future__ import annotations

@@ -10,7 +10,7 @@ the approach waypoint and NAV_LAND at home, or nothing.
 from __future__ import annotations
 
 import math
-from dataclasses import dataclass
+from dataclasses import dataclass, replace
 
 import numpy as np
 
@@ -79,10 +79,7 @@ class MissionSettings:
             if value is not None and not math.isfinite(value):
                 raise InputError(f"{name.replace('_deg', '').replace('_', ' ')} must be a number "
                                  "of degrees")
-        return MissionSettings(self.autopilot, self.altitude_m, self.airspeed_m_s, self.home_deg,
-                               self.home_altitude_amsl_m, self.launch_bearing_deg,
-                               self.landing_bearing_deg, return_mode, tolerance, max_items,
-                               self.target_acceptance_m, self.takeoff_pitch_deg)
+        return replace(self, return_mode=return_mode, tolerance_m=tolerance, max_items=max_items)
 
 
 def _fixed_items(settings: MissionSettings) -> int:

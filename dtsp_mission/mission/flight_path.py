@@ -71,14 +71,11 @@ def plan_flight_path(tour: Tour, home_m: np.ndarray, cruise_altitude_m: float,
     first, order = _open_at(tour, home, return_mode != "none")
     visits = tour.visit_s_m[order]
     start_s, end_s = visits[first], visits[first - 1]
-    if len(order) == 1:      # a single target: the whole loop through it
-        opened = SegmentChain.concatenate([tour.chain.between(start_s, length),
-                                           tour.chain.between(0.0, start_s)])
-    elif first == 0:
-        opened = tour.chain.between(start_s, end_s)
-    else:
-        opened = SegmentChain.concatenate([tour.chain.between(start_s, length),
-                                           tour.chain.between(0.0, end_s)])
+    # Forward from the first target to the last, wrapping past the end of the chain; with a
+    # single target, the whole loop through it.
+    wraps = end_s <= start_s
+    opened = SegmentChain.concatenate([tour.chain.between(start_s, length if wraps else end_s),
+                                       tour.chain.between(0.0, end_s if wraps else 0.0)])
     tour_start = opened.starts[0]
     if launch_heading_rad is None:
         towards = tour_start[:2] - home
@@ -103,8 +100,9 @@ def plan_flight_path(tour: Tour, home_m: np.ndarray, cruise_altitude_m: float,
     target_s[order[first]] = lead_in_length
     altitudes = (np.full(len(order), float(cruise_altitude_m)) if target_altitudes_m is None
                  else np.asarray(target_altitudes_m, dtype=float))
-    knots_s = [0.0, *target_s[order[np.r_[first:len(order), 0:first]]]]
-    knots_alt = [float(cruise_altitude_m), *altitudes[order[np.r_[first:len(order), 0:first]]]]
+    flown = np.roll(order, -first)
+    knots_s = [0.0, *target_s[flown]]
+    knots_alt = [float(cruise_altitude_m), *altitudes[flown]]
     if return_mode == "land":
         knots_s.append(chain.length_m)
         knots_alt.append(approach(cruise_altitude_m)[0])
