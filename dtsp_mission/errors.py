@@ -27,3 +27,16 @@ class FileAccessError(DtspError, OSError):
 
 class TourInvalidError(DtspError, ValueError):
     """A tour failed the geometric checker; the message lists what failed."""
+
+
+class LinkError(DtspError, OSError):
+    """Talking to a vehicle failed: no heartbeat, a timeout, a rejected mission.
+
+    ``on_vehicle`` says, as far as it is known, what the vehicle holds afterwards (an upload
+    to ArduPilot is not atomic); empty when nothing is known.
+    """
+
+    def __init__(self, message: str, on_vehicle: str = "") -> None:
+        super().__init__(message + (f"; {on_vehicle}" if on_vehicle else ""))
+        self.reason = message
+        self.on_vehicle = on_vehicle

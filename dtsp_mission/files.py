@@ -13,22 +13,28 @@ from pathlib import Path
 from .errors import FileAccessError
 
 
-def read_text(path: str | os.PathLike) -> str:
-    """The file's text (UTF-8, BOM accepted), or :class:`FileAccessError` saying why not."""
+def read_bytes(path: str | os.PathLike) -> bytes:
+    """The file's bytes, or :class:`FileAccessError` saying why not."""
     path = Path(path)
     try:
-        return path.read_text(encoding="utf-8-sig")
+        return path.read_bytes()
     except FileNotFoundError:
         raise FileAccessError(f"{path}: no such file") from None
     except IsADirectoryError:
         raise FileAccessError(f"{path}: is a directory, not a file") from None
     except PermissionError:
         raise FileAccessError(f"{path}: permission denied") from None
+    except OSError as error:
+        raise FileAccessError(f"{path}: cannot be read ({error.strerror})") from None
+
+
+def read_text(path: str | os.PathLike) -> str:
+    """The file's text (UTF-8, BOM accepted), or :class:`FileAccessError` saying why not."""
+    try:
+        return read_bytes(path).decode("utf-8-sig")
     except UnicodeDecodeError as error:
         raise FileAccessError(f"{path}: not a UTF-8 text file ({error.reason} at byte "
                               f"{error.start})") from None
-    except OSError as error:
-        raise FileAccessError(f"{path}: cannot be read ({error.strerror})") from None
 
 
 def write_atomic(path: str | os.PathLike, content: str | bytes) -> Path:

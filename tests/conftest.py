@@ -69,3 +69,22 @@ def mavsdk_mission_raw():
     yield MissionRaw(system)
     vehicle.destroy()
     ground.destroy()
+
+
+@pytest.fixture
+def start_vehicle():
+    """``start_vehicle(mission, **settings)``: a simulated vehicle at the mission's home on a
+    free loopback port, stopped when the test ends."""
+    from dtsp_mission.sim.flight import Airframe
+    from dtsp_mission.sim.vehicle import SimulatedVehicle, VehicleSettings
+    started = []
+
+    def start(mission, **settings):
+        settings.setdefault("airframe", Airframe(20.0, 80.0))
+        vehicle = SimulatedVehicle(VehicleSettings(mission.home, mission.autopilot, **settings))
+        started.append(vehicle.start())
+        return vehicle
+
+    yield start
+    for vehicle in started:
+        vehicle.stop()

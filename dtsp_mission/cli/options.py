@@ -69,6 +69,43 @@ vehicle_options = [
 ]
 
 
+#: How a tour becomes a mission, defined once for every command that builds one.
+mission_options = [
+    click.option("--alt", "altitude_m", type=float, default=100.0, show_default=True,
+                 metavar="METRES", help="Cruise altitude above home (targets with an 'alt' use theirs)."),
+    click.option("--home", "home_deg", type=LAT_LON,
+                 help="Launch and home position (default: the centre of the targets)."),
+    click.option("--home-amsl", "home_amsl_m", type=float, default=0.0, show_default=True,
+                 metavar="METRES", help="Home altitude above mean sea level (for the .plan)."),
+    click.option("--launch-bearing", "launch_bearing_deg", type=float, metavar="DEG",
+                 help="Take-off direction, compass degrees (default: towards the first target)."),
+    click.option("--landing-bearing", "landing_bearing_deg", type=float, metavar="DEG",
+                 help="Landing direction, compass degrees (default: the launch bearing)."),
+    click.option("--autopilot", type=click.Choice(["ardupilot", "px4"]), default="ardupilot",
+                 show_default=True, help="Autopilot flavour of the mission."),
+    click.option("--return", "return_mode", type=click.Choice(["rtl", "land", "none"]),
+                 help="After the last target: RTL, a landing at home, or nothing "
+                       "(default: rtl for ArduPilot, land for PX4)."),
+    click.option("--tolerance", "tolerance_m", type=float, metavar="METRES",
+                 help="Largest distance between the exact path and the waypoint polyline "
+                       "(default 2 % of rho; the discretiser uses a quarter of it when the "
+                       "item budget allows)."),
+    click.option("--max-items", type=int, metavar="N",
+                 help="Mission slots of the vehicle (default 700 for ArduPilot, home included; "
+                       "500 for PX4)."),
+]
+
+
+def mission_settings(autopilot, altitude_m, airspeed_m_s, home_deg, home_amsl_m,
+                     launch_bearing_deg, landing_bearing_deg, return_mode, tolerance_m,
+                     max_items):
+    """The :class:`MissionSettings` of the :data:`mission_options` values."""
+    from ..mission import MissionSettings
+    return MissionSettings(autopilot, altitude_m, airspeed_m_s, home_deg, home_amsl_m,
+                           launch_bearing_deg, landing_bearing_deg, return_mode, tolerance_m,
+                           max_items)
+
+
 def apply(options: list) -> Callable:
     """Decorate a command with a list of click options, in order."""
     def decorate(function: Callable) -> Callable:
@@ -96,3 +133,44 @@ def turn_radius_from(rho_m: float | None, airspeed_m_s: float | None,
         return rho_m, (f"rho {rho_m:g} m (a {bank_for_radius_deg(airspeed_m_s, rho_m):.0f} deg "
                        f"bank at {airspeed_m_s:g} m/s)")
     return rho_m, f"rho {rho_m:g} m"
+
+
+#: How to reach a vehicle, defined once for every command that uploads.
+link_options = [
+    click.option("--via", default="pymavlink", show_default=True,
+                 help="Uploader: pymavlink (MAVLink 2, signing) or mavsdk (MAVSDK mission_raw), "
+                      "or an installed plugin."),
+    click.option("--verify/--no-verify", default=True, show_default=True,
+                 help="Download the mission after the upload and compare it item by item."),
+    click.option("--signing-key", "signing_key_file", type=click.Path(dir_okay=False),
+                 metavar="FILE", help="Sign with this MAVLink 2 key: 32 bytes, 64 hex digits, "
+                                      "or a passphrase (its SHA-256)."),
+]
+
+#: The simulated aircraft's autopilot, defined once for `sim`, `fly` and `plan --simulate`.
+simulation_options = [
+    click.option("--speedup", type=float, default=50.0, show_default=True,
+                 help="Simulated seconds per wall-clock second (0: as fast as possible)."),
+    click.option("--l1-period", "l1_period_s", type=float, default=8.0, show_default=True,
+                 metavar="S", help="L1 navigation period of the simulated autopilot "
+                                   "(ArduPlane's NAVL1_PERIOD; its default is 17)."),
+]
+
+
+def progress_reporter(label: str):
+    """A ``progress(done, total)`` callback drawing a bar on stderr, and its closer."""
+    state: dict = {}
+
+    def progress(done: int, total: int) -> None:
+        if "bar" not in state:
+            state["bar"] = click.progressbar(length=total, label=label, file=click.get_text_stream("stderr"))
+            state["bar"].__enter__()
+            state["done"] = 0
+        state["bar"].update(done - state["done"])
+        state["done"] = done
+
+    def close() -> None:
+        if "bar" in state:
+            state["bar"].__exit__(None, None, None)
+
+    return progress, close

@@ -10,14 +10,16 @@ import shapely
 
 from ..export import exporter_for
 from ..frame import LocalFrame, mission_centre
-from ..mission import Autopilot, MissionSettings, build_mission
+from ..mission import Autopilot, build_mission
 from ..planning import TilingUnavailable, get_planner, planners
 from ..planning.lower_bounds import lower_bound
 from ..plot import draw_plan, require_matplotlib
 from ..targets import GeoTargets, Targets, random_targets, read_targets
 from ..targets.geojson_file import read_geojson
-from .options import (LAT_LON, UserError, apply, reports_errors, seed_option, turn_radius_from,
-                      vehicle_options)
+from .options import (LAT_LON, UserError, apply, link_options, mission_options,
+                      mission_settings, reports_errors, seed_option, simulation_options,
+                      turn_radius_from, vehicle_options)
+from .sim_command import airframe_from
 
 
 def _targets(targets_file: str | None, random_count: int | None, area_file: str | None,
@@ -79,28 +81,7 @@ def _duration(seconds: float) -> str:
 @click.option("--origin", type=LAT_LON, help="Place targets given in local x/y metres on the "
               "earth: LAT,LON of their (0, 0).")
 @apply(vehicle_options)
-@click.option("--alt", "altitude_m", type=float, default=100.0, show_default=True,
-              metavar="METRES", help="Cruise altitude above home (targets with an 'alt' use theirs).")
-@click.option("--home", "home_deg", type=LAT_LON,
-              help="Launch and home position (default: the centre of the targets).")
-@click.option("--home-amsl", "home_amsl_m", type=float, default=0.0, show_default=True,
-              metavar="METRES", help="Home altitude above mean sea level (for the .plan).")
-@click.option("--launch-bearing", "launch_bearing_deg", type=float, metavar="DEG",
-              help="Take-off direction, compass degrees (default: towards the first target).")
-@click.option("--landing-bearing", "landing_bearing_deg", type=float, metavar="DEG",
-              help="Landing direction, compass degrees (default: the launch bearing).")
-@click.option("--autopilot", type=click.Choice(["ardupilot", "px4"]), default="ardupilot",
-              show_default=True, help="Autopilot flavour of the mission.")
-@click.option("--return", "return_mode", type=click.Choice(["rtl", "land", "none"]),
-              help="After the last target: RTL, a landing at home, or nothing "
-                   "(default: rtl for ArduPilot, land for PX4).")
-@click.option("--tolerance", "tolerance_m", type=float, metavar="METRES",
-              help="Largest distance between the exact path and the waypoint polyline "
-                   "(default 2 % of rho; the discretiser uses a quarter of it when the "
-                   "item budget allows).")
-@click.option("--max-items", type=int, metavar="N",
-              help="Mission slots of the vehicle (default 700 for ArduPilot, home included; "
-                   "500 for PX4).")
+@apply(mission_options)
 @click.option("--algorithm", default="auto", show_default=True,
               help="Planner: " + ", ".join(sorted(planners())) + ".")
 @click.option("--region", default="bounding", show_default=True,
@@ -115,11 +96,21 @@ def _duration(seconds: float) -> str:
 @click.option("--format", "format_name", help="Output format for every -o, whatever its extension.")
 @click.option("--plot", "plot_file", type=click.Path(dir_okay=False), metavar="PNG",
               help="Draw targets, path and waypoints to this PNG file.")
+@click.option("--upload", "connection", metavar="CONNECTION",
+              help="Upload the mission to this vehicle after writing the files "
+                   "(udpout:HOST:PORT, ...); see `dtsp-mission upload`.")
+@apply(link_options)
+@click.option("--simulate", is_flag=True, help="Fly the mission in the simulator (an aircraft "
+              "turning no tighter than rho) and print per-target miss distances.")
+@apply(simulation_options)
+@click.option("--max-miss", "max_miss_m", type=float, metavar="METRES",
+              help="With --simulate: exit with status 1 if a target is missed by more than this.")
 @reports_errors
 def plan(targets_file, random_count, area_file, seed, origin, rho_m, airspeed_m_s, max_bank_deg,
          altitude_m, home_deg, home_amsl_m, launch_bearing_deg, landing_bearing_deg, autopilot,
          return_mode, tolerance_m, max_items, algorithm, region, fallback, outputs, format_name,
-         plot_file) -> None:
+         plot_file, connection, via, verify, signing_key_file, simulate, speedup, l1_period_s,
+         max_miss_m) -> None:
     """Plan a Dubins tour through the targets and write it as a mission.
 
     TARGETS_FILE: CSV with lat,lon columns (optional alt, name), or local x,y metres (with
@@ -166,9 +157,9 @@ def plan(targets_file, random_count, area_file, seed, origin, rho_m, airspeed_m_
 
     product = tour
     if frame is not None:
-        settings = MissionSettings(autopilot, altitude_m, airspeed_m_s, home_deg, home_amsl_m,
-                                   launch_bearing_deg, landing_bearing_deg, return_mode,
-                                   tolerance_m, max_items)
+        settings = mission_settings(autopilot, altitude_m, airspeed_m_s, home_deg, home_amsl_m,
+                                    launch_bearing_deg, landing_bearing_deg, return_mode,
+                                    tolerance_m, max_items)
         product = build_mission(tour, frame, geodetic, settings)
         _report_mission(product)
     elif airspeed_m_s:
@@ -180,6 +171,18 @@ def plan(targets_file, random_count, area_file, seed, origin, rho_m, airspeed_m_
     if plot_file:
         draw_plan(product, plot_file, area_m)
         click.echo(f"wrote {plot_file} (plot)")
+    if (connection or simulate) and frame is None:
+        raise UserError("--upload and --simulate need a mission in degrees: targets in lat/lon, "
+                        "or local x/y with --origin")
+    if simulate:
+        from ..sim.fly import targets_in
+        from .fly_command import run_flight_check
+        airframe, _ = airframe_from(rho, airspeed_m_s, None, l1_period_s)
+        mission = product.for_vehicle()
+        run_flight_check(mission, targets_in(mission, product.target_names), airframe, via, speedup, max_miss_m)
+    if connection:
+        from .upload_command import run_upload
+        run_upload(product.for_vehicle(), connection, via, verify, signing_key_file)
 
 
 def _report_tour(tour, positions: np.ndarray, area_m: np.ndarray | None, elapsed: float) -> None:

@@ -41,4 +41,17 @@ def exporter_for(path: str | os.PathLike, format_name: str | None = None) -> Exp
     return available[max(matches)[1]]()
 
 
-__all__ = ["EXPORTER_GROUP", "Exporter", "exporter_for", "exporters"]
+def read_mission(path: str | os.PathLike, format_name: str | None = None):
+    """The :class:`~dtsp_mission.mission.VehicleMission` in a mission file (``.plan``,
+    ``.waypoints``, or any readable plugin format)."""
+    exporter = exporter_for(path, format_name)
+    if not exporter.readable:
+        readable = ", ".join(sorted(ext for e in exporters().values()
+                                    if not isinstance(e, Exception) and e.readable
+                                    for ext in e.extensions))
+        raise InputError(f"{path}: {exporter.description or exporter.name} files hold no mission "
+                         f"items; give one of {readable}")
+    return exporter.read(path)
+
+
+__all__ = ["EXPORTER_GROUP", "Exporter", "exporter_for", "exporters", "read_mission"]

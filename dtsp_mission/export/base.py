@@ -7,7 +7,7 @@ from pathlib import Path
 
 from ..errors import InputError
 from ..files import write_atomic
-from ..mission import Mission
+from ..mission import Mission, VehicleMission
 from ..tour import Tour
 
 
@@ -34,3 +34,12 @@ class Exporter:
     def render(self, product: Mission | Tour) -> str | bytes:
         """The complete file content."""
         raise NotImplementedError
+
+    #: True when :meth:`read` gives back the mission items of a file of this format.
+    readable: bool = False
+
+    def read(self, path: str | os.PathLike) -> VehicleMission:
+        """The items, home and autopilot of a file of this format; raises
+        :class:`~dtsp_mission.errors.FileFormatError` naming what is wrong."""
+        raise InputError(f"{path}: {self.description or self.name} files cannot be read back "
+                         "as a mission")

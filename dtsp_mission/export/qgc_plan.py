@@ -13,8 +13,9 @@ import json
 import math
 from typing import Any
 
-from ..errors import TourInvalidError
-from ..mission import Mission
+from ..errors import FileFormatError, TourInvalidError
+from ..files import read_text
+from ..mission import Autopilot, Home, Mission, MissionItem, VehicleMission
 from ..mission.commands import VEHICLE_TYPE_FIXED_WING
 from .base import Exporter
 
@@ -150,3 +151,28 @@ class QGCPlanExporter(Exporter):
             raise TourInvalidError("internal error, the .plan breaks loader rules: "
                                    + "; ".join(problems))
         return json.dumps(data, indent=2, allow_nan=False) + "\n"
+
+    readable = True
+
+    def read(self, path) -> VehicleMission:
+        try:
+            data = json.loads(read_text(path))
+        except json.JSONDecodeError as error:
+            raise FileFormatError(f"{path}: not JSON ({error.msg} at line {error.lineno})") from None
+        problems = plan_rule_violations(data)
+        if problems:
+            raise FileFormatError(f"{path}: not a valid QGroundControl plan: " + "; ".join(problems[:3]))
+        mission = data["mission"]
+        try:
+            autopilot = Autopilot(mission["firmwareType"])
+        except ValueError:
+            raise FileFormatError(f"{path}: firmwareType {mission['firmwareType']} is neither "
+                                  "ArduPilot (3) nor PX4 (12)") from None
+        items = []
+        for item in mission["items"]:
+            params = [0.0 if p is None else float(p) for p in item["params"]]
+            items.append(MissionItem(item["command"], item["frame"], tuple(params[:4]), params[4],
+                                     params[5], params[6], item["autoContinue"]))
+        if not items:
+            raise FileFormatError(f"{path}: the plan holds no mission items")
+        return VehicleMission(tuple(items), Home(*mission["plannedHomePosition"]), autopilot)

@@ -13,7 +13,9 @@ from __future__ import annotations
 
 import numpy as np
 
-from ..mission import Command, Frame, Mission
+from ..errors import FileFormatError
+from ..files import read_text
+from ..mission import Autopilot, Command, Frame, Home, Mission, MissionItem, VehicleMission
 from .base import Exporter
 
 HEADER = "QGC WPL 110"
@@ -52,3 +54,30 @@ class WaypointsExporter(Exporter):
 
     def render(self, mission: Mission) -> str:
         return waypoints_text(mission)
+
+    readable = True
+
+    def read(self, path) -> VehicleMission:
+        """Line 0 is home; the format does not say the autopilot, so it is ArduPilot (the
+        format of Mission Planner and MAVProxy)."""
+        lines = [line for line in read_text(path).splitlines() if line.strip()]
+        if not lines or lines[0].strip() != HEADER:
+            raise FileFormatError(f"{path}: not a QGC WPL 110 file (the first line must be {HEADER!r})")
+        rows = []
+        for number, line in enumerate(lines[1:], start=2):
+            fields = line.split("\t")
+            try:
+                if len(fields) != 12:
+                    raise ValueError(f"{len(fields)} tab-separated fields instead of 12")
+                values = [float(f) for f in fields]
+                if not all(map(np.isfinite, values)):
+                    raise ValueError("a value is not a finite number")
+            except ValueError as error:
+                raise FileFormatError(f"{path}, line {number}: {error}") from None
+            rows.append(values)
+        if len(rows) < 2:
+            raise FileFormatError(f"{path}: no mission items after the home line")
+        home = rows[0]
+        items = tuple(MissionItem(int(r[3]), int(r[2]), tuple(r[4:8]), r[8], r[9], r[10], bool(r[11]))
+                      for r in rows[1:])
+        return VehicleMission(items, Home(home[8], home[9], home[10]), Autopilot.ARDUPILOTMEGA)

@@ -58,6 +58,17 @@ class Home:
 
 
 @dataclass(frozen=True)
+class VehicleMission:
+    """What a vehicle receives: the items, the home they are relative to, and the autopilot
+    flavour (ArduPilot keeps home at seq 0, PX4 does not).  Files read back and planned
+    missions both give this, so uploaders and the simulator need nothing else."""
+
+    items: tuple[MissionItem, ...]
+    home: Home
+    autopilot: Autopilot
+
+
+@dataclass(frozen=True)
 class FlightPath:
     """The exact path the mission flies, in the local frame: lead-in from the end of the
     climb-out, the tour opened at its best cut, and the lead-out to the landing approach.
@@ -99,6 +110,9 @@ class Mission:
         """Index (in ``items``) of the waypoint of each target, in target order."""
         index = {item.target: k for k, item in enumerate(self.items) if item.role == "target"}
         return [index[t] for t in range(len(self.tour.targets_m))]
+
+    def for_vehicle(self) -> VehicleMission:
+        return VehicleMission(self.items, self.home, self.autopilot)
 
     def vehicle_item_count(self) -> int:
         """Mission slots on the vehicle: the items plus ArduPilot's home at seq 0."""

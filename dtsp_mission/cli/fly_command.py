@@ -1,0 +1,71 @@
+"""``dtsp-mission fly``: fly a mission file in the simulator and report how close it passed
+each target -- the check before a real flight."""
+
+from __future__ import annotations
+
+import click
+import numpy as np
+
+from ..sim.fly import FlightCheck, fly_mission, targets_in
+from .options import apply, progress_reporter, reports_errors, simulation_options, vehicle_options
+from .sim_command import airframe_from
+
+
+def run_flight_check(mission, targets, airframe, via: str, speedup: float,
+                     max_miss_m: float | None) -> FlightCheck:
+    """Fly, print the report, and fail (exit 1) when ``max_miss_m`` is exceeded (shared with
+    ``plan --simulate``)."""
+    progress, close = progress_reporter("flying")
+    try:
+        check = fly_mission(mission, targets, airframe, via=via, speedup=speedup,
+                            progress=lambda stage, done, total: progress(done, total)
+                            if stage == "flight" else None)
+    finally:
+        close()
+    print_check(check)
+    if max_miss_m is not None and check.max_miss_m > max_miss_m:
+        raise click.ClickException(f"a target was missed by {check.max_miss_m:.1f} m, more than "
+                                   f"--max-miss {max_miss_m:g} m")
+    return check
+
+
+def print_check(check: FlightCheck) -> None:
+    minutes = check.flight_time_s / 60
+    state = "completed" if check.completed else "NOT completed"
+    click.echo(f"simulated flight {state}: {check.items_reached} of {check.items} items, "
+               f"{minutes:.1f} min of flight (L1 period {check.airframe.l1_period_s:g} s, "
+               f"min turn radius {check.airframe.min_turn_radius_m:g} m)")
+    click.echo(f"uploaded via {check.upload.via} in {check.upload.seconds:.2f} s; "
+               f"{check.samples} position reports received")
+    click.echo(f"smallest turn radius in the telemetry: {check.min_turn_radius_m:.1f} m")
+    if len(check.miss_m):
+        click.echo(f"targets passed within: median {np.median(check.miss_m):.2f} m, max "
+                   f"{check.max_miss_m:.2f} m")
+        click.echo("target\tmiss_m\taltitude_error_m")
+        for name, miss, altitude in zip(check.names, check.miss_m, check.altitude_error_m):
+            click.echo(f"{name}\t{miss:.2f}\t{altitude:+.1f}")
+
+
+@click.command()
+@click.argument("mission_file", type=click.Path(dir_okay=False))
+@apply(vehicle_options)
+@apply(simulation_options)
+@click.option("--via", default="pymavlink", show_default=True, help="Uploader to use.")
+@click.option("--format", "format_name", help="Format of MISSION_FILE, whatever its extension.")
+@click.option("--max-miss", "max_miss_m", type=float, metavar="METRES",
+              help="Exit with status 1 if any target is missed by more than this.")
+@reports_errors
+def fly(mission_file, rho_m, airspeed_m_s, max_bank_deg, speedup, l1_period_s, via,
+        format_name, max_miss_m) -> None:
+    """Upload MISSION_FILE to the simulated fixed wing, fly it, and print per-target miss
+    distances and the flight time.
+
+    The targets are the waypoints with an acceptance radius (how dtsp-mission writes them).
+    The aircraft turns no tighter than --radius (or --airspeed with --max-bank).
+
+    Example: dtsp-mission fly mission.plan --radius 80 --airspeed 22
+    """
+    from ..export import read_mission
+    mission = read_mission(mission_file, format_name)
+    airframe, _ = airframe_from(rho_m, airspeed_m_s, max_bank_deg, l1_period_s)
+    run_flight_check(mission, targets_in(mission), airframe, via, speedup, max_miss_m)

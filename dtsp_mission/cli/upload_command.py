@@ -1,0 +1,82 @@
+"""``dtsp-mission upload``: send a mission file to a vehicle and prove it arrived."""
+
+from __future__ import annotations
+
+import click
+
+from ..upload import upload_mission
+from ..upload.connection import read_signing_key
+from .options import (UserError, apply, link_options, mission_options, mission_settings,
+                      progress_reporter, reports_errors, vehicle_options)
+
+
+def run_upload(mission, connection: str, via: str, verify: bool, signing_key_file: str | None,
+               heartbeat_timeout_s: float | None = None) -> None:
+    """Upload with a progress bar and print what happened (shared with ``plan --upload``)."""
+    key = read_signing_key(signing_key_file) if signing_key_file else None
+    progress, close = progress_reporter("uploading")
+    click.echo(f"uploading {len(mission.items)} mission items to {connection} via {via}")
+    try:
+        report = upload_mission(mission, connection, via=via, verify=verify, signing_key=key,
+                                progress=progress, heartbeat_timeout_s=heartbeat_timeout_s)
+    finally:
+        close()
+    line = (f"the vehicle accepted {report.items} items in {report.seconds:.2f} s "
+            f"({report.resent} resent)")
+    click.echo(line + ("; downloaded back: it holds exactly the planned mission" if report.verified
+                       else "; not verified (--no-verify)"))
+
+
+@click.command()
+@click.argument("mission_file", type=click.Path(dir_okay=False))
+@click.option("--connect", "connection", required=True, metavar="CONNECTION",
+              help="The vehicle: udpout:HOST:PORT, udpin:HOST:PORT, tcp:HOST:PORT or a serial "
+                   "device like /dev/ttyACM0,57600.")
+@apply(link_options)
+@click.option("--format", "format_name", help="Format of MISSION_FILE, whatever its extension.")
+@click.option("--heartbeat-timeout", "heartbeat_timeout_s", type=float, default=5.0,
+              show_default=True, metavar="S", help="How long to wait for the vehicle.")
+@apply(mission_options)
+@vehicle_options[1]        # --airspeed, for the tour's mission
+@reports_errors
+def upload(mission_file, connection, via, verify, signing_key_file, format_name,
+           heartbeat_timeout_s, **mission_option_values) -> None:
+    """Upload MISSION_FILE (.plan, .waypoints, or a tour .json) to a vehicle over MAVLink.
+
+    A tour .json (from `plan -o tour.json`, with its frame origin) becomes a mission here,
+    with the same options as `plan` (--alt, --autopilot, --return, ...); .plan and
+    .waypoints files are sent as they are.
+
+    After the upload the mission is downloaded back and compared item by item (ArduPilot
+    uploads are not atomic); on any failure the message says what the vehicle holds.
+
+    Example: dtsp-mission upload mission.plan --connect udpout:127.0.0.1:14550
+    """
+    from ..export import exporter_for, read_mission
+    if exporter_for(mission_file, format_name).name == "tour":
+        mission = _tour_mission(mission_file, mission_settings(**mission_option_values))
+    else:
+        mission = read_mission(mission_file, format_name)
+    run_upload(mission, connection, via, verify, signing_key_file, heartbeat_timeout_s)
+
+
+def _tour_mission(path, settings):
+    """The mission of a tour file placed on the earth by its frame origin."""
+    import json
+
+    from ..files import read_text
+    from ..frame import LocalFrame
+    from ..mission import build_mission
+    from ..targets.model import local_targets
+    from ..tour import read_tour
+    from ..tour.json_form import origin_from_dict
+    tour = read_tour(path)
+    origin = origin_from_dict(json.loads(read_text(path)))
+    if origin is None:
+        raise UserError(f"{path}: the tour has no frame origin, so it cannot be placed on the "
+                        "earth; plan from lat/lon targets (or with --origin) and write the .json again")
+    frame = LocalFrame(*origin)
+    targets = local_targets(tour.targets_m).to_geodetic(frame)
+    mission = build_mission(tour, frame, targets, settings)
+    click.echo(f"mission from the tour: {len(mission.items)} items")
+    return mission.for_vehicle()

@@ -1,0 +1,164 @@
+"""Checking a mission before a real flight: upload it to the simulated vehicle over loopback
+UDP, fly it, and measure from the vehicle's own telemetry how close it passed each target.
+
+Miss distances come from the GLOBAL_POSITION_INT stream a ground station receives (the
+closest approach of the reported track to each target), not from the simulator's insides;
+the flight time is the simulator's clock.
+"""
+
+from __future__ import annotations
+
+import math
+import os
+import time
+from dataclasses import dataclass
+from typing import Callable
+
+import numpy as np
+
+os.environ.setdefault("MAVLINK20", "1")
+
+from pymavlink import mavutil  # noqa: E402
+
+from ..errors import LinkError  # noqa: E402
+from ..mission import Command, VehicleMission  # noqa: E402
+from ..upload import UploadReport, upload_mission  # noqa: E402
+from .flight import Airframe, closest_approach_m  # noqa: E402
+from .vehicle import MAV_CMD_MISSION_START, SimulatedVehicle, VehicleSettings  # noqa: E402
+
+
+@dataclass(frozen=True)
+class Targets:
+    """Where the targets are: degrees, altitude above home (NaN: not checked), names."""
+
+    latitudes_deg: np.ndarray
+    longitudes_deg: np.ndarray
+    altitudes_m: np.ndarray
+    names: tuple[str, ...]
+
+
+def targets_in(mission: VehicleMission, names: tuple[str, ...] | None = None) -> Targets:
+    """The mission's targets in visiting order: its ``target`` items (named from ``names``
+    by target index), or -- for items read from a file, which carry no roles -- every
+    NAV_WAYPOINT with an acceptance radius (how dtsp-mission writes targets)."""
+    chosen = [item for item in mission.items if item.role == "target"]
+    if chosen:
+        labels = tuple(names[i.target] if names else f"target {i.target}" for i in chosen)
+    else:
+        numbered = [(seq, item) for seq, item in enumerate(mission.items, start=1)
+                    if item.command == Command.NAV_WAYPOINT and item.params[1] > 0]
+        chosen = [item for _, item in numbered]
+        labels = tuple(f"item {seq}" for seq, _ in numbered)
+    return Targets(np.array([i.latitude_deg for i in chosen]),
+                   np.array([i.longitude_deg for i in chosen]),
+                   np.array([i.altitude_m for i in chosen]), labels)
+
+
+@dataclass(frozen=True)
+class FlightCheck:
+    """What the simulated flight showed."""
+
+    upload: UploadReport
+    completed: bool
+    flight_time_s: float
+    items_reached: int
+    items: int
+    miss_m: np.ndarray                 # per target, horizontal closest approach
+    altitude_error_m: np.ndarray       # per target, reported minus planned, at closest approach
+    names: tuple[str, ...]
+    min_turn_radius_m: float           # smallest radius seen in the telemetry (1 s windows)
+    samples: int
+    airframe: Airframe
+
+    @property
+    def max_miss_m(self) -> float:
+        return float(self.miss_m.max()) if len(self.miss_m) else 0.0
+
+
+def fly_mission(mission: VehicleMission, targets: Targets, airframe: Airframe,
+                via: str = "pymavlink", speedup: float = 50.0, telemetry_hz: float = 10.0,
+                progress: Callable[[str, int, int], None] | None = None,
+                timeout_s: float | None = None) -> FlightCheck:
+    """Upload ``mission`` to a simulated vehicle with ``airframe``, fly it, and measure."""
+    settings = VehicleSettings(mission.home, mission.autopilot, airframe, speedup,
+                               telemetry_hz=telemetry_hz)
+    with SimulatedVehicle(settings) as vehicle:
+        connection = f"udpout:127.0.0.1:{vehicle.port}"
+        report = upload_mission(mission, connection, via=via,
+                                progress=(lambda d, t: progress("upload", d, t)) if progress else None)
+        track, reached = _watch(vehicle, connection, mission, speedup, progress, timeout_s)
+        flight_time = vehicle.log.reached[-1][1] if vehicle.log.reached else 0.0
+        items = len(vehicle.mission)
+    local_track = vehicle.frame.to_local(track[:, 0], track[:, 1]) if len(track) else np.zeros((0, 2))
+    local_targets = vehicle.frame.to_local(targets.latitudes_deg, targets.longitudes_deg)
+    if len(local_track) >= 2:
+        miss = closest_approach_m(local_track, local_targets)
+        # The altitude error where the track comes closest in 3-D: a target under the
+        # climb-out is overflown low first and at altitude later.
+        nearest = np.array([int(np.argmin(np.hypot(np.hypot(*(local_track - p).T), track[:, 2] - z)))
+                            for p, z in zip(local_targets, targets.altitudes_m)])
+        altitude_error = track[nearest, 2] - targets.altitudes_m
+    else:
+        miss = np.full(len(local_targets), np.inf)
+        altitude_error = np.full(len(local_targets), np.nan)
+    return FlightCheck(report, reached == items - 1, flight_time, reached + 1, items, miss,
+                       altitude_error, targets.names, _min_turn_radius(local_track, track[:, 3:5],
+                                                                       telemetry_hz),
+                       len(track), airframe)
+
+
+def _watch(vehicle: SimulatedVehicle, connection: str, mission: VehicleMission, speedup: float,
+           progress, timeout_s: float | None) -> tuple[np.ndarray, int]:
+    """Start the mission with MAV_CMD_MISSION_START and record the telemetry until the last
+    item is reached; returns rows (lat, lon, relative alt, v_north, v_east) and the highest
+    seq reached."""
+    link = mavutil.mavlink_connection(connection, source_system=255, source_component=190,
+                                      dialect="common")
+    rows = []
+    highest = -1
+    last_seq = len(vehicle.mission) - 1
+    try:
+        link.mav.heartbeat_send(6, 8, 0, 0, 0)
+        link.mav.command_long_send(1, 1, MAV_CMD_MISSION_START, 0, 0, 0, 0, 0, 0, 0, 0)
+        ack = link.recv_match(type="COMMAND_ACK", blocking=True, timeout=5)
+        if ack is None or ack.result != 0:
+            raise LinkError("the simulated vehicle did not start the mission")
+        length = sum(1 for _ in mission.items)
+        budget = timeout_s or 60.0 + 4 * 3600 / max(speedup, 1.0) + length
+        deadline = time.monotonic() + budget
+        last_heartbeat = 0.0
+        while highest < last_seq:
+            if time.monotonic() > deadline:
+                raise LinkError(f"the simulated flight did not finish within {budget:.0f} s "
+                                f"(reached item {highest} of {last_seq})")
+            if time.monotonic() - last_heartbeat > 1.0:
+                link.mav.heartbeat_send(6, 8, 0, 0, 0)
+                last_heartbeat = time.monotonic()
+            message = link.recv_match(type=["GLOBAL_POSITION_INT", "MISSION_ITEM_REACHED"],
+                                      blocking=True, timeout=0.5)
+            if message is None:
+                continue
+            if message.get_type() == "GLOBAL_POSITION_INT":
+                rows.append((message.lat / 1e7, message.lon / 1e7, message.relative_alt / 1e3,
+                             message.vx / 100.0, message.vy / 100.0))
+            elif message.seq > highest:
+                highest = message.seq
+                if progress is not None:
+                    progress("flight", highest, last_seq)
+    finally:
+        link.close()
+    return np.array(rows).reshape(-1, 5), highest
+
+
+def _min_turn_radius(track_m: np.ndarray, velocity_ne: np.ndarray, rate_hz: float) -> float:
+    """Smallest radius over 1 s windows: distance flown over heading change, from positions
+    and the reported velocity (turns of less than 3 degrees in a window are straight)."""
+    window = max(2, int(round(rate_hz)))
+    if len(track_m) <= window:
+        return math.inf
+    heading = np.unwrap(np.arctan2(velocity_ne[:, 0], velocity_ne[:, 1]))
+    step = np.hypot(*np.diff(track_m, axis=0).T)
+    flown = np.convolve(step, np.ones(window), "valid")
+    turned = np.abs(heading[window:] - heading[:-window])
+    turning = turned > math.radians(3)
+    return float((flown[turning] / turned[turning]).min()) if turning.any() else math.inf

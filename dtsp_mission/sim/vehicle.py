@@ -1,0 +1,372 @@
+"""A simulated fixed-wing vehicle that speaks MAVLink: MAVSDK's server plugins serve the
+mission protocol and telemetry, :class:`~dtsp_mission.sim.flight.MissionFlight` flies.
+
+MAVSDK runs on a ``raw://`` connection; this module owns the UDP socket and sits between it
+and the ground station, adding what the server plugins do not do: a heartbeat as a fixed
+wing of the chosen autopilot, an item limit answered with MAV_MISSION_NO_SPACE, MAVLink 2
+signing, MAV_CMD_MISSION_START, and a restart (fault injection).  Everything else -- upload,
+download, MISSION_CURRENT, MISSION_ITEM_REACHED, positions -- is MAVSDK's.
+"""
+
+from __future__ import annotations
+
+import math
+import socket
+import threading
+import time
+from dataclasses import dataclass, field
+
+import numpy as np
+from pymavlink.dialects.v20 import common as mavlink2
+
+from ..frame import LocalFrame
+from ..mavsdk_log import quiet_mavsdk_log
+from ..mission import Autopilot, Frame
+from ..mission.model import Home
+from ..upload.wire import WireItem, first_mission_seq
+from ..vehicle import heading_to_bearing_deg
+from .flight import Airframe, LocalItem, MissionFlight
+
+MAV_TYPE_FIXED_WING = 1
+MAV_CMD_MISSION_START = 300
+MAV_RESULT_ACCEPTED = 0
+MAV_RESULT_DENIED = 2
+MAV_MISSION_NO_SPACE = 4
+MAV_STATE_STANDBY, MAV_STATE_ACTIVE = 3, 4
+MAV_MODE_FLAG_CUSTOM_MODE_ENABLED = 1
+MAV_MODE_FLAG_AUTO_ENABLED = 4
+MAV_MODE_FLAG_SAFETY_ARMED = 128
+MAV_SEVERITY_ERROR = 3
+SIGNING_EPOCH_S = 1420070400     # MAVLink 2 signing timestamps count from 2015-01-01
+
+
+@dataclass(frozen=True)
+class VehicleSettings:
+    """The simulated vehicle: where it stands, how it flies, and the faults it shows."""
+
+    home: Home
+    autopilot: Autopilot = Autopilot.ARDUPILOTMEGA
+    airframe: Airframe = Airframe()
+    speedup: float = 50.0             # simulated seconds per wall second; 0: as fast as possible
+    step_s: float = 0.05
+    telemetry_hz: float = 10.0        # position messages per simulated second
+    max_items: int | None = None      # mission slots (home included on ArduPilot)
+    signing_key: bytes | None = None
+    autostart: bool = False           # fly as soon as a mission arrives
+    restart_at_item: int | None = None   # fault: reboot when this item arrives in an upload
+    restart_s: float = 1.0            # how long a reboot keeps it silent (wall seconds)
+
+
+@dataclass
+class FlightLog:
+    """What the vehicle flew: samples (simulated time, x, y, altitude above home) in the
+    local frame centred on home, and the items it completed."""
+
+    samples: list[tuple[float, float, float, float]] = field(default_factory=list)
+    reached: list[tuple[int, float]] = field(default_factory=list)
+
+
+class _Sender:
+    """pymavlink's output file: datagrams to the current ground station."""
+
+    def __init__(self, vehicle: "SimulatedVehicle") -> None:
+        self.vehicle = vehicle
+
+    def write(self, data: bytes) -> None:
+        self.vehicle._send_datagram(bytes(data))
+
+
+class SimulatedVehicle:
+    """The vehicle, listening on ``udpin`` ``host:port`` (port 0 picks a free one).  Ground
+    stations connect with ``udpout:HOST:PORT``; replies go to whoever spoke last, or to
+    ``gcs`` (host, port) before anyone did.  Use as a context manager or call
+    :meth:`start` and :meth:`stop`."""
+
+    def __init__(self, settings: VehicleSettings, port: int = 0, host: str = "127.0.0.1",
+                 gcs: tuple[str, int] | None = None) -> None:
+        self.settings = settings
+        self.frame = LocalFrame(settings.home.latitude_deg, settings.home.longitude_deg)
+        self._socket = socket.socket(socket.AF_INET, socket.SOCK_DGRAM)
+        self._socket.bind((host, port))
+        self._socket.settimeout(0.1)
+        self.host, self.port = self._socket.getsockname()
+        self._peer = gcs
+        # _lock: the flight and every call into MAVSDK from our threads.  _link_lock: the
+        # pymavlink parser and encoder, used from MAVSDK's send callback, which therefore
+        # never waits for _lock (MAVSDK's destroy joins that callback's thread).
+        self._lock = threading.RLock()
+        self._link_lock = threading.Lock()
+        self._start_requested = False
+        self._stop = threading.Event()
+        self.finished = threading.Event()
+        self.mission: list[WireItem] = []     # the last mission the plugins accepted
+        self.uploads = 0
+        self.restarts = 0
+        self.log = FlightLog()
+        self.flight: MissionFlight | None = None
+        self._mavsdk = None
+        self._restarting = False
+        self._restart_done = False
+        self._parser_in = mavlink2.MAVLink(None)
+        self._parser_out = mavlink2.MAVLink(None)
+        self._encoder = mavlink2.MAVLink(_Sender(self), srcSystem=1, srcComponent=1)
+        if settings.signing_key is not None:
+            self._parser_in.signing.secret_key = settings.signing_key
+            self._encoder.signing.secret_key = settings.signing_key
+            self._encoder.signing.sign_outgoing = True
+            self._encoder.signing.timestamp = int((time.time() - SIGNING_EPOCH_S) * 1e5)
+        self._threads: list[threading.Thread] = []
+
+    # -- life cycle --------------------------------------------------------------------------
+
+    def start(self) -> "SimulatedVehicle":
+        self._boot()
+        for target in (self._receive_loop, self._flight_loop):
+            thread = threading.Thread(target=target, daemon=True, name=f"sim-{target.__name__}")
+            thread.start()
+            self._threads.append(thread)
+        return self
+
+    def stop(self) -> None:
+        self._stop.set()
+        for thread in self._threads:
+            thread.join(timeout=5)
+        self._shutdown_mavsdk()
+        self._socket.close()
+
+    def __enter__(self) -> "SimulatedVehicle":
+        return self.start()
+
+    def __exit__(self, *exc) -> None:
+        self.stop()
+
+    def _boot(self) -> None:
+        from mavsdk import ComponentType, Configuration, Mavsdk
+        from mavsdk.plugins.mission_raw_server import MissionRawServer
+        from mavsdk.plugins.telemetry_server import Position, TelemetryServer
+        quiet_mavsdk_log()
+        mavsdk = Mavsdk(Configuration.create_with_component_type(ComponentType.AUTOPILOT))
+        mavsdk.add_any_connection("raw://")
+        mavsdk.subscribe_raw_bytes_to_be_sent(self._from_mavsdk)
+        server = mavsdk.server_component()
+        self._missions = MissionRawServer(server)
+        self._telemetry = TelemetryServer(server)
+        self._missions.subscribe_incoming_mission(self._on_mission)
+        self._missions.subscribe_clear_all(lambda *_: self._set_mission([]))
+        home = self.settings.home
+        self._telemetry.publish_home(Position(home.latitude_deg, home.longitude_deg,
+                                              home.altitude_amsl_m, 0.0))
+        self._mavsdk = mavsdk
+
+    def _shutdown_mavsdk(self) -> None:
+        """Destroy MAVSDK without holding a lock its callbacks might wait for."""
+        with self._lock:
+            mavsdk, self._mavsdk = self._mavsdk, None
+        if mavsdk is not None:
+            mavsdk.destroy()
+
+    def restart(self) -> None:
+        """Reboot: silent for ``restart_s``, then up again without a mission."""
+        self._restarting = True
+        self.restarts += 1
+        self._shutdown_mavsdk()
+        self.mission = []
+        time.sleep(self.settings.restart_s)
+        with self._lock:
+            self._boot()
+            self._restarting = False
+
+    # -- the link ----------------------------------------------------------------------------
+
+    def _send_datagram(self, data: bytes) -> None:
+        peer = self._peer
+        if peer is not None and not self._stop.is_set():
+            try:
+                self._socket.sendto(data, peer)
+            except OSError:
+                pass
+
+    def _from_mavsdk(self, data: bytes) -> None:
+        """Bytes MAVSDK sends: heartbeats become a fixed wing's; with signing, every message
+        is signed."""
+        if self._restarting or self._stop.is_set():
+            return
+        signing = self.settings.signing_key is not None
+        heartbeat = (data[:1] == b"\xfd" and data[7:10] == b"\x00\x00\x00") or \
+            (data[:1] == b"\xfe" and data[5:6] == b"\x00")        # msgid 0 is HEARTBEAT
+        if not signing and not heartbeat:
+            self._send_datagram(data)
+            return
+        with self._link_lock:
+            messages = self._parser_out.parse_buffer(data) or []
+            for message in messages:
+                if message.get_type() == "BAD_DATA":
+                    continue
+                if message.get_type() == "HEARTBEAT":
+                    self._as_fixed_wing(message)
+                elif not signing:
+                    self._send_datagram(message.get_msgbuf())
+                    continue
+                self._encoder.srcSystem = message.get_srcSystem()
+                self._encoder.srcComponent = message.get_srcComponent()
+                self._encoder.send(message)
+
+    def _as_fixed_wing(self, heartbeat) -> None:
+        flying = self.flight is not None and not self.finished.is_set()
+        heartbeat.type = MAV_TYPE_FIXED_WING
+        heartbeat.autopilot = int(self.settings.autopilot)
+        heartbeat.base_mode = MAV_MODE_FLAG_CUSTOM_MODE_ENABLED | (
+            MAV_MODE_FLAG_AUTO_ENABLED | MAV_MODE_FLAG_SAFETY_ARMED if flying else 0)
+        heartbeat.system_status = MAV_STATE_ACTIVE if flying else MAV_STATE_STANDBY
+
+    def _receive_loop(self) -> None:
+        while not self._stop.is_set():
+            try:
+                data, address = self._socket.recvfrom(65535)
+            except socket.timeout:
+                continue
+            except OSError:
+                return
+            if self._restarting:
+                continue
+            self._peer = address
+            with self._lock:
+                try:
+                    messages = self._parser_in.parse_buffer(data) or []
+                except mavlink2.MAVError:       # a bad signature: drop the datagram
+                    signing = self._parser_in.signing
+                    self._parser_in = mavlink2.MAVLink(None)
+                    self._parser_in.signing = signing
+                    continue
+            for message in messages:
+                if message.get_type() == "BAD_DATA":
+                    continue       # a wrong signature, or no signature while signing: ignored
+                if not self._handled_here(message):
+                    with self._lock:
+                        if self._mavsdk is not None and not self._restarting:
+                            self._mavsdk.pass_received_raw_bytes(bytes(message.get_msgbuf()))
+
+    def _handled_here(self, message) -> bool:
+        """Answer what the plugins cannot; True when the message must not reach them."""
+        kind = message.get_type()
+        settings = self.settings
+        if kind == "MISSION_COUNT" and message.mission_type == 0 and settings.max_items is not None \
+                and message.count > settings.max_items:
+            with self._link_lock:
+                self._encoder.srcSystem, self._encoder.srcComponent = 1, 1
+                self._encoder.statustext_send(
+                    MAV_SEVERITY_ERROR, f"Mission too long: {settings.max_items} items fit".encode())
+                self._encoder.mission_ack_send(message.get_srcSystem(), message.get_srcComponent(),
+                                               MAV_MISSION_NO_SPACE, 0)
+            return True
+        if kind == "MISSION_ITEM_INT" and settings.restart_at_item is not None \
+                and message.seq == settings.restart_at_item and not self._restart_done:
+            self._restart_done = True
+            threading.Thread(target=self.restart, daemon=True).start()
+            return True
+        if kind == "COMMAND_LONG" and message.command == MAV_CMD_MISSION_START:
+            started = self.start_mission()
+            with self._link_lock:
+                self._encoder.srcSystem, self._encoder.srcComponent = 1, 1
+                self._encoder.command_ack_send(
+                    MAV_CMD_MISSION_START, MAV_RESULT_ACCEPTED if started else MAV_RESULT_DENIED,
+                    0, 0, message.get_srcSystem(), message.get_srcComponent())
+            return True
+        return False
+
+    # -- the mission ---------------------------------------------------------------------------
+
+    def _set_mission(self, items: list[WireItem]) -> None:
+        self.mission = items
+
+    def _on_mission(self, result, plan, _user_data=None) -> None:
+        if getattr(result, "name", "") != "SUCCESS" or plan is None:
+            return
+        self.uploads += 1
+        self._set_mission([WireItem.normalised(i.seq, i.frame, i.command, i.current,
+                                               i.autocontinue, i.param1, i.param2, i.param3,
+                                               i.param4, i.x, i.y, i.z, i.mission_type)
+                           for i in plan.mission_items])
+        if self.settings.autostart:
+            self._start_requested = True     # the flight loop starts it, off MAVSDK's thread
+
+    def local_items(self) -> list[LocalItem]:
+        """The mission in the local frame (altitudes above home)."""
+        items = []
+        home_amsl = self.settings.home.altitude_amsl_m
+        for item in self.mission:
+            if item.frame == Frame.MISSION:
+                x = y = math.nan
+            else:
+                x, y = self.frame.to_local(np.array([item.x / 1e7]), np.array([item.y / 1e7]))[0]
+            altitude = item.z - home_amsl if item.frame == Frame.GLOBAL else item.z
+            items.append(LocalItem(item.seq, item.command, float(x), float(y), altitude,
+                                   (item.param1, item.param2, item.param3, item.param4)))
+        return items
+
+    def start_mission(self) -> bool:
+        """Take off and fly the mission from its first item; False without a mission or
+        while flying."""
+        with self._lock:
+            first = first_mission_seq(self.settings.autopilot)
+            items = self.local_items()
+            if len(items) <= first or (self.flight is not None and not self.finished.is_set()):
+                return False
+            ahead = next((i for i in items[first:] if not math.isnan(i.x_m)
+                          and math.hypot(i.x_m, i.y_m) > 1.0), None)
+            heading = math.atan2(ahead.y_m, ahead.x_m) if ahead is not None else 0.0
+            self.log = FlightLog()
+            self.finished.clear()
+            self._completed = 0
+            if first:     # ArduPilot: home is item 0, never flown
+                self._missions.set_current_item_complete()
+            self.flight = MissionFlight(items, self.settings.airframe, heading, first)
+            return True
+
+    def _flight_loop(self) -> None:
+        settings = self.settings
+        publish_every = max(1, round(1.0 / (settings.telemetry_hz * settings.step_s)))
+        steps = 0
+        paced_from = None
+        while not self._stop.is_set():
+            if self._start_requested:
+                self._start_requested = False
+                self.start_mission()
+            flight = self.flight
+            if flight is None or self.finished.is_set() or self._restarting:
+                paced_from = None
+                time.sleep(0.01)
+                continue
+            if paced_from is None:
+                paced_from = (time.monotonic(), flight.state.time_s)
+            with self._lock:
+                flight.step(settings.step_s)
+                steps += 1
+                state = flight.state
+                self.log.samples.append((state.time_s, state.x_m, state.y_m, state.alt_m))
+                while self._completed < len(flight.reached):
+                    self.log.reached.append(flight.reached[self._completed])
+                    self._completed += 1
+                    if self._mavsdk is not None:
+                        self._missions.set_current_item_complete()
+                if steps % publish_every == 0 or flight.finished:
+                    self._publish(state)
+                if flight.finished:
+                    self.finished.set()
+            if settings.speedup > 0:
+                ahead = (state.time_s - paced_from[1]) / settings.speedup \
+                    - (time.monotonic() - paced_from[0])
+                if ahead > 0.002:
+                    time.sleep(ahead)
+
+    def _publish(self, state) -> None:
+        from mavsdk.plugins.telemetry_server import Heading, Position, VelocityNed
+        if self._mavsdk is None:
+            return
+        latitude, longitude = self.frame.to_geodetic(np.array([[state.x_m, state.y_m]]))
+        speed = state.airspeed_m_s
+        self._telemetry.publish_position(
+            Position(float(latitude[0]), float(longitude[0]),
+                     self.settings.home.altitude_amsl_m + state.alt_m, state.alt_m),
+            VelocityNed(speed * math.sin(state.heading_rad), speed * math.cos(state.heading_rad), 0.0),
+            Heading(heading_to_bearing_deg(state.heading_rad)))

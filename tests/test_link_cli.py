@@ -1,0 +1,124 @@
+"""The `upload`, `fly`, `sim` and `plan --upload/--simulate` commands, end to end over
+loopback UDP."""
+
+from __future__ import annotations
+
+import os
+import re
+import subprocess
+import sys
+import time
+
+import pytest
+from click.testing import CliRunner
+
+from conftest import free_udp_port, make_mission
+from dtsp_mission.cli.main import cli
+from dtsp_mission.export import exporter_for
+from dtsp_mission.upload.wire import differences, to_wire
+
+SITE = os.path.join(os.path.dirname(__file__), "..", "examples", "site-inspection.csv")
+
+
+@pytest.fixture(scope="module")
+def mission():
+    return make_mission(8, 4, 80.0, span_m=1200.0, airspeed_m_s=20.0)
+
+
+def run(*args):
+    return CliRunner().invoke(cli, [str(a) for a in args], catch_exceptions=False)
+
+
+@pytest.mark.parametrize("suffix,via", [(".plan", "pymavlink"), (".waypoints", "mavsdk")])
+def test_upload_command_puts_the_file_on_the_vehicle(mission, tmp_path, start_vehicle, suffix, via):
+    path = tmp_path / f"m{suffix}"
+    exporter_for(path).write(mission, path)
+    vehicle = start_vehicle(mission)
+    result = run("upload", path, "--connect", f"udpout:127.0.0.1:{vehicle.port}", "--via", via)
+    assert result.exit_code == 0, result.output
+    assert "holds exactly the planned mission" in result.output
+    assert not differences(to_wire(mission.for_vehicle()), vehicle.mission, mission.autopilot)
+
+
+def test_upload_command_errors(mission, tmp_path, start_vehicle):
+    path = tmp_path / "m.plan"
+    exporter_for(path).write(mission, path)
+    vehicle = start_vehicle(mission, max_items=10)
+    result = run("upload", path, "--connect", f"udpout:127.0.0.1:{vehicle.port}")
+    assert result.exit_code == 2 and "no room for" in result.output
+    assert "holds no mission" in result.output
+    result = run("upload", path, "--connect", f"udpout:127.0.0.1:{free_udp_port()}",
+                 "--heartbeat-timeout", "1")
+    assert result.exit_code == 2 and "no heartbeat" in result.output
+    result = run("upload", tmp_path / "missing.plan", "--connect", "udpout:127.0.0.1:1")
+    assert result.exit_code == 2 and "no such file" in result.output
+    (tmp_path / "bad.plan").write_text("{}")
+    result = run("upload", tmp_path / "bad.plan", "--connect", "udpout:127.0.0.1:1")
+    assert result.exit_code == 2 and "not a valid QGroundControl plan" in result.output
+    result = run("upload", tmp_path / "m.geojson", "--connect", "udpout:127.0.0.1:1")
+    assert result.exit_code == 2
+
+
+def test_fly_command_reports_every_target(mission, tmp_path):
+    path = tmp_path / "m.plan"
+    exporter_for(path).write(mission, path)
+    result = run("fly", path, "--radius", 80, "--airspeed", 20, "--speedup", 400)
+    assert result.exit_code == 0, result.output
+    assert "simulated flight completed" in result.output
+    rows = re.findall(r"^item \d+\t([\d.]+)\t", result.output, re.M)
+    assert len(rows) == 8 and max(map(float, rows)) <= 20.0
+    strict = run("fly", path, "--radius", 80, "--airspeed", 20, "--speedup", 400,
+                 "--max-miss", 0.001)
+    assert strict.exit_code == 1 and "missed by" in strict.output
+
+
+def test_plan_simulate_and_upload_in_one_go(tmp_path, start_vehicle, mission):
+    vehicle = start_vehicle(mission)       # any home: the vehicle takes what it is sent
+    out = tmp_path / "site.plan"
+    result = run("plan", SITE, "--radius", 80, "--alt", 120, "--airspeed", 22, "--max-items",
+                 4000, "-o", out, "--upload", f"udpout:127.0.0.1:{vehicle.port}")
+    assert result.exit_code == 0, result.output
+    assert out.exists() and "holds exactly the planned mission" in result.output
+    assert len(vehicle.mission) == len(exporter_for(out).read(out).items) + 1
+
+
+def test_sim_command_runs_as_a_process_and_accepts_uploads(mission, tmp_path):
+    path = tmp_path / "m.plan"
+    exporter_for(path).write(mission, path)
+    port = free_udp_port()
+    process = subprocess.Popen(
+        [sys.executable, "-m", "dtsp_mission.cli", "sim", "--listen", f"127.0.0.1:{port}",
+         "--home", f"{mission.home.latitude_deg},{mission.home.longitude_deg}",
+         "--radius", "80", "--airspeed", "20", "--speedup", "400", "--autostart"],
+        stdout=subprocess.PIPE, stderr=subprocess.STDOUT, text=True,
+        env={**os.environ, "PYTHONUNBUFFERED": "1"})
+    try:
+        time.sleep(1.5)
+        result = run("upload", path, "--connect", f"udpout:127.0.0.1:{port}")
+        assert result.exit_code == 0, result.output
+        time.sleep(5)      # about 250 s of flight at 400x, and the sim's 0.2 s report cycle
+    finally:
+        process.terminate()
+        output, _ = process.communicate(timeout=10)
+    assert "listening on udp 127.0.0.1" in output
+    assert f"mission received: {len(to_wire(mission.for_vehicle()))} items" in output
+    assert "mission complete" in output
+
+
+def test_upload_a_tour_json_builds_the_mission_with_plan_options(tmp_path, start_vehicle, mission):
+    tour = tmp_path / "tour.json"
+    result = run("plan", SITE, "--radius", 80, "--max-items", 4000, "-o", tour)
+    assert result.exit_code == 0, result.output
+    vehicle = start_vehicle(mission)
+    result = run("upload", tour, "--connect", f"udpout:127.0.0.1:{vehicle.port}",
+                 "--max-items", 4000, "--alt", 150, "--autopilot", "px4")
+    assert result.exit_code == 0, result.output
+    assert "holds exactly the planned mission" in result.output
+    assert vehicle.mission[0].command == 22 and vehicle.mission[-1].command == 21   # PX4: takeoff first, land last
+    assert {item.z for item in vehicle.mission if item.command == 16 and item.param2 > 0} == {150.0}
+    bare = tmp_path / "bare.json"
+    assert run("plan", tmp_path / "local.csv", "--radius", 80).exit_code == 2   # missing file
+    (tmp_path / "local.csv").write_text("x,y\n0,0\n500,0\n0,500\n")
+    assert run("plan", tmp_path / "local.csv", "--radius", 80, "-o", bare).exit_code == 0
+    result = run("upload", bare, "--connect", f"udpout:127.0.0.1:{vehicle.port}")
+    assert result.exit_code == 2 and "no frame origin" in result.output
