@@ -9,22 +9,20 @@ the flight time is the simulator's clock.
 from __future__ import annotations
 
 import math
-import os
 import time
 from dataclasses import dataclass
 from typing import Callable
 
 import numpy as np
 
-os.environ.setdefault("MAVLINK20", "1")
+from pymavlink import mavutil
 
-from pymavlink import mavutil  # noqa: E402
-
-from ..errors import LinkError  # noqa: E402
-from ..mission import Command, VehicleMission  # noqa: E402
-from ..upload import UploadReport, upload_mission  # noqa: E402
-from .flight import Airframe, closest_approach_m  # noqa: E402
-from .vehicle import MAV_CMD_MISSION_START, SimulatedVehicle, VehicleSettings  # noqa: E402
+from ..errors import LinkError
+from ..mission import Command, VehicleMission
+from ..upload import UploadReport, upload_mission
+from ..upload.pymavlink_link import GCS_COMPONENT_ID, GCS_SYSTEM_ID, use_mavlink2
+from .flight import Airframe, closest_approach_m
+from .vehicle import MAV_CMD_MISSION_START, SimulatedVehicle, VehicleSettings
 
 
 @dataclass(frozen=True)
@@ -112,8 +110,9 @@ def _watch(vehicle: SimulatedVehicle, connection: str, mission: VehicleMission, 
     """Start the mission with MAV_CMD_MISSION_START and record the telemetry until the last
     item is reached; returns rows (lat, lon, relative alt, v_north, v_east) and the highest
     seq reached."""
-    link = mavutil.mavlink_connection(connection, source_system=255, source_component=190,
-                                      dialect="common")
+    use_mavlink2()
+    link = mavutil.mavlink_connection(connection, source_system=GCS_SYSTEM_ID,
+                                      source_component=GCS_COMPONENT_ID)
     rows = []
     highest = -1
     last_seq = len(vehicle.mission) - 1

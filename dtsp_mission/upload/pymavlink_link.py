@@ -12,22 +12,29 @@ from __future__ import annotations
 import os
 import time
 
-os.environ.setdefault("MAVLINK20", "1")   # before pymavlink picks its wire protocol
+from pymavlink import mavutil
 
-from pymavlink import mavutil  # noqa: E402
-
-from ..errors import LinkError  # noqa: E402
-from ..mission import Command  # noqa: E402
-from .connection import check_host  # noqa: E402
-from .base import ITEM_TIMEOUT_S, RETRIES, TIMEOUT_S, Progress, Uploader  # noqa: E402
-from .results import ITEM_RESULTS, NO_SPACE, result_text  # noqa: E402
-from .wire import MISSION_TYPE_MISSION, WireItem  # noqa: E402
+from ..errors import LinkError
+from ..mission import Command
+from .connection import check_host
+from .base import ITEM_TIMEOUT_S, RETRIES, TIMEOUT_S, Progress, Uploader
+from .results import ITEM_RESULTS, NO_SPACE, result_text
+from .wire import MISSION_TYPE_MISSION, WireItem
 
 GCS_SYSTEM_ID = 255
 GCS_COMPONENT_ID = 190          # MAV_COMP_ID_MISSIONPLANNER
 MAV_TYPE_GCS = 6
 MAV_AUTOPILOT_INVALID = 8
 HEARTBEAT_PERIOD_S = 1.0
+
+
+def use_mavlink2() -> None:
+    """Switch pymavlink to MAVLink 2.  pymavlink keeps its wire protocol in a process-wide
+    dialect module chosen from ``MAVLINK20``; the variable and the module are changed together
+    so other pymavlink users in the process (``MAVWPLoader``) stay consistent."""
+    if os.environ.get("MAVLINK20") != "1" or mavutil.mavlink.WIRE_PROTOCOL_VERSION != "2.0":
+        os.environ["MAVLINK20"] = "1"
+        mavutil.set_dialect(os.environ.get("MAVLINK_DIALECT", "ardupilotmega"))
 
 
 def _command_name(command: int) -> str:
@@ -45,12 +52,12 @@ class PymavlinkUploader(Uploader):
     supports_signing = True
 
     def open(self) -> None:
-        os.environ["MAVLINK20"] = "1"
+        use_mavlink2()
         check_host(self.connection)
         try:
             self._link = mavutil.mavlink_connection(
                 self.connection, source_system=GCS_SYSTEM_ID, source_component=GCS_COMPONENT_ID,
-                dialect="common", autoreconnect=False)
+                autoreconnect=False)
         except Exception as error:  # pymavlink raises OSError, ValueError, serial errors ...
             raise LinkError(f"cannot open the connection {self.connection!r}: {error}") from None
         if self.signing_key is not None:
