@@ -18,6 +18,7 @@ from dtsp_mission.mission.model import waypoint
 from dtsp_mission.sim.fault_proxy import FaultProxy, Faults
 from dtsp_mission.sim.vehicle import SimulatedVehicle, VehicleSettings
 from dtsp_mission.upload import upload_mission
+from dtsp_mission.upload.wire import differences, to_wire
 
 HOME = Home(46.8, 6.95, 450.0)
 
@@ -37,10 +38,13 @@ def one_upload(mission: VehicleMission, via: str, loss: float, seed: int) -> tup
             port = proxy.port if loss else vehicle.port
             started = time.perf_counter()
             try:
-                report = upload_mission(mission, f"udpout:127.0.0.1:{port}", via=via, verify=False)
+                upload_mission(mission, f"udpout:127.0.0.1:{port}", via=via, verify=False)
                 elapsed = time.perf_counter() - started
-                ok = vehicle.mission and len(vehicle.mission) == report.items
-                return elapsed, "ok" if ok else "vehicle differs"
+                waited = time.monotonic() + 5     # the vehicle stores the mission after its ACK
+                while not vehicle.uploads and time.monotonic() < waited:
+                    time.sleep(0.01)
+                same = not differences(to_wire(mission), vehicle.mission, mission.autopilot)
+                return elapsed, "ok" if same else "vehicle differs"
             except LinkError as error:
                 return time.perf_counter() - started, f"failed: {error.reason[:60]}"
 

@@ -25,6 +25,8 @@ def run_upload(mission, connection: str, via: str, verify: bool, signing_key_fil
             f"({report.resent} resent)")
     click.echo(line + ("; downloaded back: it holds exactly the planned mission" if report.verified
                        else "; not verified (--no-verify)"))
+    if report.note:
+        click.echo(f"note: {report.note}", err=True)
 
 
 @click.command()

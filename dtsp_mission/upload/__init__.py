@@ -44,6 +44,7 @@ class UploadReport:
     seconds: float
     resent: int
     verified: bool
+    note: str = ""
 
 
 def upload_mission(mission: VehicleMission, connection: str, via: str = "pymavlink",
@@ -65,8 +66,18 @@ def upload_mission(mission: VehicleMission, connection: str, via: str = "pymavli
         try:
             uploader.upload(wire, progress)
         except LinkError as error:
-            raise LinkError(f"upload failed: {error.reason}",
-                            _what_is_aboard(uploader, wire, mission, verify)) from None
+            on_vehicle = _download_or_none(uploader) if verify else None
+            if on_vehicle is not None and not differences(wire, on_vehicle, mission.autopilot):
+                # The transfer broke off (typically the final ACK was lost), but the vehicle
+                # demonstrably holds the plan: that is a verified upload.
+                return UploadReport(via, len(wire), time.perf_counter() - started,
+                                    uploader.resent, True,
+                                    f"the transfer ended without an acknowledgement "
+                                    f"({error.reason}), but the mission downloaded from the "
+                                    "vehicle is exactly the plan")
+            what = (describe_vehicle(on_vehicle, wire, mission.autopilot) if verify else
+                    "the vehicle may hold part of this mission (not checked: --no-verify)")
+            raise LinkError(f"upload failed: {error.reason}", what) from None
         if verify:
             try:
                 on_vehicle = uploader.download()
@@ -83,15 +94,11 @@ def upload_mission(mission: VehicleMission, connection: str, via: str = "pymavli
                             verify)
 
 
-def _what_is_aboard(uploader: Uploader, wire: list[WireItem], mission: VehicleMission,
-                    verify: bool) -> str:
-    if not verify:
-        return "the vehicle may hold part of this mission (not checked: --no-verify)"
+def _download_or_none(uploader: Uploader) -> list[WireItem] | None:
     try:
-        on_vehicle = uploader.download()
+        return uploader.download()
     except LinkError:
-        on_vehicle = None
-    return describe_vehicle(on_vehicle, wire, mission.autopilot)
+        return None
 
 
 def download_mission(connection: str, via: str = "pymavlink",

@@ -151,16 +151,19 @@ class PymavlinkUploader(Uploader):
         quiet_since = time.monotonic()
         kinds = {"MISSION_REQUEST_INT", "MISSION_REQUEST", "MISSION_ACK"}
         while True:
-            # Resend every ITEM_TIMEOUT_S while quiet; give up after RETRIES quiet TIMEOUT_S.
+            # Wait in ITEM_TIMEOUT_S steps; after TIMEOUT_S of quiet send the count or the
+            # last item again (one retry).  Resending faster only restarts the vehicle's own
+            # request timer, which is what re-asks for a lost item.
             message = self._receive(kinds, ITEM_TIMEOUT_S)
             if message is None:
+                if time.monotonic() - quiet_since < TIMEOUT_S:
+                    continue
+                retries += 1
                 self.resent += 1
-                if time.monotonic() - quiet_since >= TIMEOUT_S:
-                    retries += 1
-                    quiet_since = time.monotonic()
-                    if retries > RETRIES:
-                        raise self._no_answer("no request for the first item" if highest < 0
-                                              else f"after item {highest} of {count}")
+                quiet_since = time.monotonic()
+                if retries > RETRIES:
+                    raise self._no_answer("no request for the first item" if highest < 0
+                                          else f"after item {highest} of {count}")
                 if highest < 0:
                     self._link.mav.mission_count_send(system, component, count, MISSION_TYPE_MISSION)
                 else:
