@@ -33,3 +33,8 @@ def load_group(group: str, accepts: Callable[[object], bool],
             log.warning("%s plugin %r is broken: %r", group, entry_point.name, error)
             found[entry_point.name] = error
     return found
+
+
+def working(found: dict[str, object | Exception]) -> dict[str, object]:
+    """The plugins of a :func:`load_group` result that loaded."""
+    return {name: plugin for name, plugin in found.items() if not isinstance(plugin, Exception)}

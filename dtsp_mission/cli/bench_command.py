@@ -71,10 +71,11 @@ def planners_bench(sizes, seeds, rho_m, side_m, names, csv_file, json_file, mark
     from ..bench import planners as planner_bench
     from ..files import write_atomic
     from ..planning import planners
+    from ..plugins import working
     from ..plot import require_matplotlib
     if plot_file:
         require_matplotlib()
-    installed = [n for n, p in planners().items() if not isinstance(p, Exception)]
+    installed = list(working(planners()))
     chosen = installed if names is None else [n.strip() for n in names.split(",") if n.strip()]
     unknown = sorted(set(chosen) - set(installed))
     if unknown:

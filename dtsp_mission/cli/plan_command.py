@@ -19,7 +19,6 @@ from ..targets.geojson_file import read_geojson
 from .options import (LAT_LON, UserError, apply, link_options, mission_options,
                       mission_settings, reports_errors, seed_option, simulation_options,
                       turn_radius_from, vehicle_options)
-from .sim_command import airframe_from
 
 
 def _targets(targets_file: str | None, random_count: int | None, area_file: str | None,
@@ -177,6 +176,7 @@ def plan(targets_file, random_count, area_file, seed, origin, rho_m, airspeed_m_
     if simulate:
         from ..sim.fly import targets_in
         from .fly_command import run_flight_check
+        from .sim_command import airframe_from
         airframe, _ = airframe_from(rho, airspeed_m_s, None, l1_period_s)
         mission = product.for_vehicle()
         run_flight_check(mission, targets_in(mission, product.target_names), airframe, via, speedup, max_miss_m)

@@ -11,7 +11,7 @@ import os
 from pathlib import Path
 
 from ..errors import InputError
-from ..plugins import load_group
+from ..plugins import load_group, working
 from .base import Exporter
 
 EXPORTER_GROUP = "dtsp_mission.exporters"
@@ -25,7 +25,7 @@ def exporters() -> dict[str, type[Exporter] | Exception]:
 
 def exporter_for(path: str | os.PathLike, format_name: str | None = None) -> Exporter:
     """The exporter named ``format_name``, or else the one whose extensions match ``path``."""
-    available = {n: e for n, e in exporters().items() if not isinstance(e, Exception)}
+    available = working(exporters())
     if format_name is not None:
         if format_name not in available:
             raise InputError(f"unknown output format {format_name!r} (installed: "
@@ -46,8 +46,7 @@ def read_mission(path: str | os.PathLike, format_name: str | None = None):
     ``.waypoints``, or any readable plugin format)."""
     exporter = exporter_for(path, format_name)
     if not exporter.readable:
-        readable = ", ".join(sorted(ext for e in exporters().values()
-                                    if not isinstance(e, Exception) and e.readable
+        readable = ", ".join(sorted(ext for e in working(exporters()).values() if e.readable
                                     for ext in e.extensions))
         raise InputError(f"{path}: {exporter.description or exporter.name} files hold no mission "
                          f"items; give one of {readable}")

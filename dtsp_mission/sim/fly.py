@@ -122,8 +122,7 @@ def _watch(vehicle: SimulatedVehicle, connection: str, mission: VehicleMission, 
         ack = link.recv_match(type="COMMAND_ACK", blocking=True, timeout=5)
         if ack is None or ack.result != 0:
             raise LinkError("the simulated vehicle did not start the mission")
-        length = sum(1 for _ in mission.items)
-        budget = timeout_s or 60.0 + 4 * 3600 / max(speedup, 1.0) + length
+        budget = timeout_s or 60.0 + 4 * 3600 / max(speedup, 1.0) + len(mission.items)
         deadline = time.monotonic() + budget
         last_heartbeat = 0.0
         while highest < last_seq:

@@ -14,7 +14,7 @@ from dataclasses import dataclass
 
 from ..errors import InputError, LinkError
 from ..mission import VehicleMission
-from ..plugins import load_group
+from ..plugins import load_group, working
 from .base import Progress, Uploader
 from .wire import WireItem, describe_vehicle, differences, to_wire
 
@@ -28,7 +28,7 @@ def uploaders() -> dict[str, type[Uploader] | Exception]:
 
 
 def get_uploader(name: str) -> type[Uploader]:
-    available = {n: u for n, u in uploaders().items() if not isinstance(u, Exception)}
+    available = working(uploaders())
     if name not in available:
         raise InputError(f"unknown uploader {name!r} (installed: {', '.join(sorted(available))})")
     return available[name]

@@ -9,7 +9,7 @@ lists compare equal exactly when the vehicle holds the planned mission.
 
 from __future__ import annotations
 
-from dataclasses import astuple, dataclass, fields
+from dataclasses import dataclass, fields
 
 import numpy as np
 
@@ -48,9 +48,6 @@ class WireItem:
         return cls(int(seq), int(frame), int(command), int(current), int(bool(autocontinue)),
                    _f32(param1), _f32(param2), _f32(param3), _f32(param4), int(x), int(y),
                    _f32(z), int(mission_type))
-
-    def as_tuple(self) -> tuple:
-        return astuple(self)
 
 
 #: Fields compared between plan and vehicle (``current`` is state, not content).
