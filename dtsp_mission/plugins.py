@@ -35,6 +35,17 @@ def load_group(group: str, accepts: Callable[[object], bool],
     return found
 
 
+def origins(group: str) -> dict[str, str]:
+    """For each entry point of ``group``, the distribution that provides it ("name version"),
+    without loading anything."""
+    found: dict[str, str] = {}
+    for entry_point in sorted(entry_points(group=group), key=lambda e: e.name):
+        dist = entry_point.dist
+        found.setdefault(entry_point.name,
+                         f"{dist.metadata['Name']} {dist.version}" if dist is not None else "?")
+    return found
+
+
 def working(found: dict[str, object | Exception]) -> dict[str, object]:
     """The plugins of a :func:`load_group` result that loaded."""
     return {name: plugin for name, plugin in found.items() if not isinstance(plugin, Exception)}

@@ -12,6 +12,17 @@ settings.register_profile("ci", deadline=None, derandomize=True, print_blob=True
 settings.load_profile("ci")
 
 
+def environment_with_distribution(directory, name: str, entry_points: str) -> dict[str, str]:
+    """Process environment in which an installed distribution ``name`` 1.0 with the given
+    ``entry_points.txt`` text is on the path (how a third-party plugin looks to Python)."""
+    import os
+    dist = directory / f"{name.replace('-', '_')}-1.0.dist-info"
+    dist.mkdir()
+    (dist / "METADATA").write_text(f"Metadata-Version: 2.1\nName: {name}\nVersion: 1.0\n")
+    (dist / "entry_points.txt").write_text(entry_points)
+    return dict(os.environ, PYTHONPATH=str(directory) + os.pathsep + os.environ.get("PYTHONPATH", ""))
+
+
 def assert_valid_tour(tour: Tour) -> None:
     """Fail with the checker's own list of problems unless ``tour`` is valid."""
     report = check_tour(tour)

@@ -8,6 +8,7 @@ import textwrap
 import numpy as np
 import pytest
 
+from conftest import environment_with_distribution
 from dtsp_mission.tour import tour_through_poses, tour_to_dict, write_tour
 
 
@@ -45,15 +46,10 @@ def test_check_command_on_valid_and_broken_tours(tmp_path, rng):
 
 def test_a_broken_plugin_is_reported_and_the_cli_still_works(tmp_path):
     """A distribution on the path whose command entry point cannot be imported."""
-    dist = tmp_path / "broken_plugin-1.0.dist-info"
-    dist.mkdir()
-    (dist / "METADATA").write_text("Metadata-Version: 2.1\nName: broken-plugin\nVersion: 1.0\n")
-    (dist / "entry_points.txt").write_text(textwrap.dedent("""\
+    env = environment_with_distribution(tmp_path, "broken-plugin", textwrap.dedent("""\
         [dtsp_mission.commands]
         exploding = no_such_module_anywhere:command
         """))
-    import os
-    env = dict(os.environ, PYTHONPATH=str(tmp_path) + os.pathsep + os.environ.get("PYTHONPATH", ""))
     listing = run("--help", env=env)
     assert listing.returncode == 0
     assert "exploding" in listing.stdout and "broken plugin" in listing.stdout

@@ -8,8 +8,9 @@ import click
 import numpy as np
 import shapely
 
+from ..api import local_frame_for
 from ..export import exporter_for
-from ..frame import LocalFrame, mission_centre
+from ..frame import LocalFrame
 from ..mission import Autopilot, build_mission
 from ..planning import TilingUnavailable, get_planner, planners
 from ..planning.lower_bounds import lower_bound
@@ -55,8 +56,8 @@ def _frame(targets: GeoTargets | Targets, origin) -> tuple[Targets, GeoTargets |
         if origin is not None:
             raise UserError("--origin is for targets in local x/y metres; these are in lat/lon")
         # The readers checked the coordinates; in_frame checks that they fit the frame.
-        frame = LocalFrame(*mission_centre(targets.latitudes_deg, targets.longitudes_deg))
-        return targets.in_frame(frame), targets, frame
+        frame, local = local_frame_for(targets)
+        return local, targets, frame
     if origin is None:
         return targets, None, None
     frame = LocalFrame(*origin)

@@ -12,7 +12,7 @@ from pathlib import Path
 
 from ..errors import InputError
 from ..plugins import load_group, working
-from .base import Exporter
+from .base import Exporter, flight_path_deg
 
 EXPORTER_GROUP = "dtsp_mission.exporters"
 
@@ -53,4 +53,4 @@ def read_mission(path: str | os.PathLike, format_name: str | None = None):
     return exporter.read(path)
 
 
-__all__ = ["EXPORTER_GROUP", "Exporter", "exporter_for", "exporters", "read_mission"]
+__all__ = ["EXPORTER_GROUP", "Exporter", "exporter_for", "exporters", "flight_path_deg", "read_mission"]

@@ -2,13 +2,28 @@
 
 from __future__ import annotations
 
+import math
 import os
 from pathlib import Path
+
+import numpy as np
 
 from ..errors import InputError
 from ..files import write_atomic
 from ..mission import Mission, VehicleMission
+from ..mission.discretise import candidate_s
 from ..tour import Tour
+
+#: Arcs of the flight path are sampled at least this often for drawing formats.
+PATH_STEP_RAD = math.radians(2.0)
+
+
+def flight_path_deg(mission: Mission, step_rad: float = PATH_STEP_RAD) -> tuple[np.ndarray, np.ndarray]:
+    """Latitudes and longitudes (WGS84 degrees) of the flown path, sampled from its exact
+    segments: every segment end, and arcs every ``step_rad`` of turn, so the polyline stays
+    within ``rho (1 - cos(step_rad / 2))`` of the path (1.5e-4 rho at the default)."""
+    s, _ = candidate_s(mission.path.chain, step_rad, np.zeros(0), 0.0)
+    return mission.frame.to_geodetic(mission.path.chain.pose_at(s)[:, :2])
 
 
 class Exporter:

@@ -2,22 +2,18 @@
 
 Positions are ``[longitude, latitude]`` in WGS84 degrees; altitudes (metres above home) are
 in the properties, because a GeoJSON third coordinate would mean height above the ellipsoid.
-The path is sampled from the exact segments every 2 degrees of turn (lines only at their
-ends), so it stays within ``rho (1 - cos 1 deg)`` (1.5e-4 rho) of the exact path.
+The path is sampled from the exact segments by :func:`~dtsp_mission.export.base.flight_path_deg`
+(arcs every 2 degrees of turn, lines only at their ends).
 """
 
 from __future__ import annotations
 
 import json
-import math
 
 import numpy as np
 
 from ..mission import Mission
-from ..mission.discretise import candidate_s
-from .base import Exporter
-
-PATH_STEP_RAD = math.radians(2.0)
+from .base import Exporter, flight_path_deg
 
 
 def _point(latitude: float, longitude: float, properties: dict) -> dict:
@@ -28,8 +24,7 @@ def _point(latitude: float, longitude: float, properties: dict) -> dict:
 def geojson_dict(mission: Mission) -> dict:
     """The mission as a GeoJSON FeatureCollection."""
     path = mission.path
-    s, _ = candidate_s(path.chain, PATH_STEP_RAD, np.zeros(0), 0.0)
-    latitudes, longitudes = mission.frame.to_geodetic(path.chain.pose_at(s)[:, :2])
+    latitudes, longitudes = flight_path_deg(mission)
     features = [{
         "type": "Feature",
         "geometry": {"type": "LineString",

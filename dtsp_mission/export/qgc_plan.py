@@ -144,8 +144,12 @@ class QGCPlanExporter(Exporter):
     extensions = (".plan",)
     description = "QGroundControl .plan file"
 
+    def document(self, mission: Mission) -> dict[str, Any]:
+        """The plan document to write (a subclass may add a fence or rally points)."""
+        return plan_dict(mission)
+
     def render(self, mission: Mission) -> str:
-        data = plan_dict(mission)
+        data = self.document(mission)
         problems = plan_rule_violations(data)
         if problems:   # a bug here, never the user's input: say so instead of writing it
             raise TourInvalidError("internal error, the .plan breaks loader rules: "

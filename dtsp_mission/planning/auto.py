@@ -8,6 +8,7 @@ from ..tour import Tour
 from .alternating import AlternatingPlanner
 from .base import Planner
 from .headings import HeadingsPlanner
+from .lanes import LanesPlanner
 from .rbta import RBTAPlanner
 from .region import Region
 from .tiling import TilingUnavailable
@@ -15,7 +16,7 @@ from .tiling import TilingUnavailable
 
 class AutoPlanner(Planner):
     """The shortest of the RBTA (when the targets are numerous enough to tile), the Alternating
-    Algorithm and the heading-optimised Euclidean tour; ``report["candidates"]`` lists every
+    Algorithm, the heading-optimised Euclidean tour and the lanes; ``report["candidates"]`` lists every
     length measured."""
 
     name = "auto"
@@ -24,7 +25,8 @@ class AutoPlanner(Planner):
     def _plan(self, targets_m: np.ndarray, rho_m: float, region: Region | None) -> Tour:
         candidates: dict[str, float | str] = {}
         best: Tour | None = None
-        for planner in (AlternatingPlanner(), HeadingsPlanner(), RBTAPlanner(**self.parameters)):
+        for planner in (AlternatingPlanner(), HeadingsPlanner(), LanesPlanner(),
+                        RBTAPlanner(**self.parameters)):
             try:
                 tour = planner.plan(targets_m, rho_m, region)
             except TilingUnavailable as error:

@@ -145,27 +145,41 @@ def straight_through_headings(points_m: np.ndarray) -> np.ndarray:
     return np.arctan2(chord[:, 1], chord[:, 0])
 
 
+def headings_over_candidates(points_m: np.ndarray, candidates_rad: np.ndarray, rho_m: float,
+                             refine_half_width_rad: float, sweeps: int = 3) -> np.ndarray:
+    """Headings at the points of a closed visiting order: the shortest cycle over the given
+    candidates (row ``i`` of ``candidates_rad`` for point ``i``), exactly, then each heading
+    refined within +-``refine_half_width_rad`` while that shortens the tour.  The result is
+    never longer than the best choice among the candidates."""
+    points = np.ascontiguousarray(points_m, dtype=float)
+    candidates = np.ascontiguousarray(candidates_rad, dtype=float)
+    choice = _best_cycle(_edge_costs(points, candidates, float(rho_m)))
+    headings = candidates[np.arange(len(points)), choice].copy()
+    _refine(points, headings, float(rho_m), float(refine_half_width_rad), sweeps, 24)
+    return headings
+
+
+def edge_directions(points_m: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """Direction of the edge into and out of each point of a closed order (radians)."""
+    outgoing = np.roll(points_m, -1, axis=0) - points_m
+    outgoing = np.arctan2(outgoing[:, 1], outgoing[:, 0])
+    return np.roll(outgoing, 1), outgoing
+
+
 def optimise_headings(points_m: np.ndarray, rho_m: float, candidate_count: int = 16,
                       sweeps: int = 3) -> np.ndarray:
     """Headings (radians) at the points of a closed visiting order that make the tour of
     shortest Dubins paths short: exact over ``candidate_count`` candidates per point, then
     refined continuously (see the module docstring)."""
     points = np.ascontiguousarray(points_m, dtype=float)
-    n = len(points)
     natural = straight_through_headings(points)
-    if n == 1:
+    if len(points) == 1:
         return natural
-    outgoing = np.roll(points, -1, axis=0) - points
-    outgoing = np.arctan2(outgoing[:, 1], outgoing[:, 0])
-    incoming = np.roll(outgoing, 1)
+    incoming, outgoing = edge_directions(points)
     spread = candidate_count - 2
     offsets = 2.0 * np.pi * np.arange(spread) / spread
-    candidates = np.ascontiguousarray(np.column_stack(
-        [incoming, outgoing, natural[:, None] + offsets[None, :]]))
-    choice = _best_cycle(_edge_costs(points, candidates, float(rho_m)))
-    headings = candidates[np.arange(n), choice].copy()
-    _refine(points, headings, float(rho_m), np.pi / candidate_count, sweeps, 24)
-    return headings
+    candidates = np.column_stack([incoming, outgoing, natural[:, None] + offsets[None, :]])
+    return headings_over_candidates(points, candidates, rho_m, np.pi / candidate_count, sweeps)
 
 
 def closed_length_m(points_m: np.ndarray, headings_rad: np.ndarray, rho_m: float) -> float:

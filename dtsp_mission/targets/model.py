@@ -62,6 +62,13 @@ class GeoTargets:
     def with_area(self, area_deg: np.ndarray | None) -> "GeoTargets":
         return replace(self, area_deg=area_deg)
 
+    def subset(self, indices: np.ndarray) -> "GeoTargets":
+        """The targets at ``indices`` (in that order), with their names and altitudes."""
+        keep = np.asarray(indices, dtype=np.int64)
+        return replace(self, latitudes_deg=self.latitudes_deg[keep],
+                       longitudes_deg=self.longitudes_deg[keep], names=_pick(self.names, keep),
+                       altitudes_m=_pick(self.altitudes_m, keep), merged_duplicates=0)
+
 
 def check_altitudes(altitudes_m: np.ndarray | None, where: str) -> None:
     """Raise :class:`InputError` unless every altitude is a finite number above zero."""
