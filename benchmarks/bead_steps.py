@@ -29,16 +29,14 @@ from dtsp_mission.bench.measure import format_table
 from dtsp_mission.files import write_atomic
 from dtsp_mission.planning import bounding_region, get_planner
 from dtsp_mission.planning.lower_bounds import stochastic_lower_bound
-from dtsp_mission.planning.tiling import BeadTiling, bead_half_length
+from dtsp_mission.planning.tiling import BeadTiling
 
 SIDE_M, RHO_M = 5000.0, 100.0
 
 
 def bead_row_spacing_m(targets_m: np.ndarray) -> float:
     """Distance between the axes of the RBTA's bead rows for these targets."""
-    region = bounding_region(targets_m)
-    l_m = bead_half_length(region.area_m2, len(targets_m), RHO_M)
-    return BeadTiling(l_m, RHO_M, region.width_m, region.height_m).row_spacing_m
+    return BeadTiling.for_region(bounding_region(targets_m), len(targets_m), RHO_M).row_spacing_m
 
 
 def steps(targets_m: np.ndarray) -> list[tuple[str, str, dict]]:

@@ -25,7 +25,7 @@ import matplotlib.pyplot as plt  # noqa: E402
 
 from dtsp_mission.files import write_atomic  # noqa: E402
 from dtsp_mission.planning import bead, bounding_region, get_planner  # noqa: E402
-from dtsp_mission.planning.tiling import BeadTiling, bead_half_length  # noqa: E402
+from dtsp_mission.planning.tiling import BeadTiling  # noqa: E402
 
 RHO_M = 100.0
 
@@ -68,8 +68,7 @@ def bead_figure(path: Path) -> None:
 
 def tiling_figure(path: Path, targets: np.ndarray) -> None:
     region = bounding_region(targets)
-    tiling = BeadTiling(bead_half_length(region.area_m2, len(targets), RHO_M), RHO_M,
-                        region.width_m, region.height_m)
+    tiling = BeadTiling.for_region(region, len(targets), RHO_M)
     local = region.to_local(targets)
     rows, columns = tiling.bead_of(local)
     figure, axes = plt.subplots(figsize=(8, 6))

@@ -17,6 +17,11 @@ from ..plugins import load_group
 COMMAND_GROUP = "dtsp_mission.commands"
 
 
+def commands() -> dict[str, click.Command | Exception]:
+    """Installed commands by name; a plugin that fails to load maps to its error."""
+    return load_group(COMMAND_GROUP, lambda c: isinstance(c, click.Command), "a click command")
+
+
 def _broken_command(name: str, error: BaseException) -> click.Command:
     @click.command(name=name, help=f"(broken plugin: {error.__class__.__name__})")
     def broken() -> None:
@@ -25,20 +30,18 @@ def _broken_command(name: str, error: BaseException) -> click.Command:
 
 
 class PluginGroup(click.Group):
-    """A click group whose commands come from an entry-point group, loaded on first use."""
+    """A click group whose commands come from the ``dtsp_mission.commands`` entry-point group,
+    loaded on first use."""
 
-    def __init__(self, *args, entry_point_group: str, **kwargs) -> None:
+    def __init__(self, *args, **kwargs) -> None:
         super().__init__(*args, **kwargs)
-        self._entry_point_group = entry_point_group
         self._loaded = False
 
     def _load(self) -> None:
         if self._loaded:
             return
         self._loaded = True
-        loaded = load_group(self._entry_point_group, lambda c: isinstance(c, click.Command),
-                            "a click command")
-        for name, command in loaded.items():
+        for name, command in commands().items():
             if name in self.commands:
                 continue
             if isinstance(command, Exception):
@@ -54,7 +57,7 @@ class PluginGroup(click.Group):
         return super().get_command(ctx, name)
 
 
-@click.group(cls=PluginGroup, entry_point_group=COMMAND_GROUP,
+@click.group(cls=PluginGroup,
              context_settings={"help_option_names": ["-h", "--help"]})
 @click.version_option(__version__, prog_name="dtsp-mission")
 @click.option("-v", "--verbose", count=True, help="More log output (repeatable).")

@@ -8,20 +8,15 @@ import click
 
 from ..export import EXPORTER_GROUP, exporters
 from ..planning import PLANNER_GROUP, planners
-from ..plugins import load_group, origins
+from ..plugins import origins
 from ..upload import UPLOADER_GROUP, uploaders
-from .main import COMMAND_GROUP
-
-
-def _commands() -> dict[str, object]:
-    return load_group(COMMAND_GROUP, lambda c: isinstance(c, click.Command), "a click command")
-
+from .main import COMMAND_GROUP, commands
 
 #: (group label, entry-point group, loader) for every plugin group, in pipeline order.
 GROUPS = (("planners", PLANNER_GROUP, planners),
           ("exporters", EXPORTER_GROUP, exporters),
           ("uploaders", UPLOADER_GROUP, uploaders),
-          ("commands", COMMAND_GROUP, _commands))
+          ("commands", COMMAND_GROUP, commands))
 
 
 def _summary(plugin: object) -> str:

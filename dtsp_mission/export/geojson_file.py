@@ -37,9 +37,7 @@ def geojson_dict(mission: Mission) -> dict:
     features.append(_point(home.latitude_deg, home.longitude_deg,
                            {"kind": "home", "altitude_amsl_m": home.altitude_amsl_m}))
     item_of_target = mission.target_items
-    order = np.argsort(path.target_s_m, kind="stable")
-    rank = np.empty(len(order), dtype=int)
-    rank[order] = np.arange(len(order))
+    rank = mission.visit_numbers
     for target, item_index in enumerate(item_of_target):
         item = mission.items[item_index]
         properties = {"kind": "target", "target": target, "visit": int(rank[target]),

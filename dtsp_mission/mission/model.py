@@ -111,6 +111,14 @@ class Mission:
         index = {item.target: k for k, item in enumerate(self.items) if item.role == "target"}
         return [index[t] for t in range(len(self.tour.targets_m))]
 
+    @property
+    def visit_numbers(self) -> np.ndarray:
+        """0-based position of each target (in target order) in the visiting order."""
+        order = np.argsort(self.path.target_s_m, kind="stable")
+        numbers = np.empty(len(order), dtype=np.int64)
+        numbers[order] = np.arange(len(order))
+        return numbers
+
     def for_vehicle(self) -> VehicleMission:
         return VehicleMission(self.items, self.home, self.autopilot)
 

@@ -182,10 +182,15 @@ def optimise_headings(points_m: np.ndarray, rho_m: float, candidate_count: int =
     return headings_over_candidates(points, candidates, rho_m, np.pi / candidate_count, sweeps)
 
 
+def leg_lengths_m(points_m: np.ndarray, headings_rad: np.ndarray, rho_m: float) -> np.ndarray:
+    """Shortest Dubins length of each leg ``i -> i + 1`` of the closed tour through the poses."""
+    poses = np.column_stack([points_m, headings_rad])
+    return shortest_length(poses, np.roll(poses, -1, axis=0), rho_m)
+
+
 def closed_length_m(points_m: np.ndarray, headings_rad: np.ndarray, rho_m: float) -> float:
     """Length of the closed tour of shortest Dubins paths through the given poses."""
-    poses = np.column_stack([points_m, headings_rad])
-    return float(shortest_length(poses, np.roll(poses, -1, axis=0), rho_m).sum())
+    return float(leg_lengths_m(points_m, headings_rad, rho_m).sum())
 
 
 class HeadingsPlanner(Planner):

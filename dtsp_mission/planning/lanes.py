@@ -29,11 +29,11 @@ import math
 
 import numpy as np
 
-from ..dubins import shortest_length
 from ..tour import Tour, tour_through_poses
 from .alternating import alternating_headings
 from .base import Planner
-from .headings import closed_length_m, edge_directions, headings_over_candidates
+from .headings import (closed_length_m, edge_directions, headings_over_candidates,
+                       leg_lengths_m)
 from .region import Region, minimum_area_region
 
 #: Lane widths tried, as multiples of the natural width (A^2 / (n^2 rho))^(1/3).
@@ -88,15 +88,14 @@ def lane_headings(points_m: np.ndarray, direction: np.ndarray, rho_m: float, fan
     return headings_over_candidates(points_m, candidates, rho_m, fan_rad / (candidate_count - 2), 2)
 
 
-def looped_edges(points_m: np.ndarray, headings_rad: np.ndarray, lanes: np.ndarray,
+def looped_edges(points_m: np.ndarray, legs_m: np.ndarray, lanes: np.ndarray,
                  rho_m: float) -> np.ndarray:
-    """Indices ``i`` of the edges (visit i -> i + 1) inside one lane whose shortest path is at
-    least ``pi rho`` longer than the straight line: the ones that need a loop."""
-    poses = np.column_stack([points_m, headings_rad])
-    dubins = shortest_length(poses, np.roll(poses, -1, axis=0), rho_m)
+    """Indices ``i`` of the edges (visit i -> i + 1) inside one lane whose shortest path
+    (``legs_m[i]``, :func:`~.headings.leg_lengths_m`) is at least ``pi rho`` longer than the
+    straight line: the ones that need a loop."""
     straight = np.hypot(*(np.roll(points_m, -1, axis=0) - points_m).T)
     same_lane = lanes == np.roll(lanes, -1)
-    return np.flatnonzero(same_lane & (dubins - straight > np.pi * rho_m))
+    return np.flatnonzero(same_lane & (legs_m - straight > np.pi * rho_m))
 
 
 def repaired_lanes(lanes: np.ndarray, across_m: np.ndarray, width_m: float, order: np.ndarray,
@@ -180,12 +179,13 @@ class LanesPlanner(Planner):
             points = local[order]
             headings = (lane_headings(points, direction, rho_m, fan, candidate_count)
                         if dp_headings else alternating_headings(points))
-            length = closed_length_m(points, headings, rho_m)
+            legs = leg_lengths_m(points, headings, rho_m)
+            length = float(legs.sum())
             if best is None or length < best[0]:
                 best = (length, order, headings)
             if round_ == rounds:
                 break
-            loops = looped_edges(points, headings, lanes[order], rho_m)
+            loops = looped_edges(points, legs, lanes[order], rho_m)
             if len(loops) == 0:
                 break
             lanes = repaired_lanes(lanes, local[:, 1], width_m, order, loops, lane_count)

@@ -38,7 +38,7 @@ from . import bead
 from .alternating import alternating_visits
 from .base import Planner
 from .region import Region, bounding_region, minimum_area_region
-from .tiling import BeadTiling, bead_half_length, phase_shape
+from .tiling import BeadTiling, phase_shape
 
 HEADING_GRID = 72
 GOLDEN_STEPS = 40
@@ -236,8 +236,7 @@ class RBTAPlanner(Planner):
         n = len(targets_m)
         region = region or self.region_for(targets_m)
         local = region.to_local(targets_m)
-        tiling = BeadTiling(bead_half_length(region.area_m2, n, rho_m), rho_m, region.width_m,
-                            region.height_m)
+        tiling = BeadTiling.for_region(region, n, rho_m)
         bead_rows, bead_columns = tiling.bead_of(local)
         home = np.array([0.0, region.height_m, 0.0])
         remaining = np.ones(n, dtype=bool)

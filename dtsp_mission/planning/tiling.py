@@ -59,6 +59,12 @@ class BeadTiling:
     width_m: float
     height_m: float
 
+    @classmethod
+    def for_region(cls, region, n: int, rho_m: float) -> "BeadTiling":
+        """The paper's tiling of ``region`` (a :class:`~.region.Region`) for ``n`` targets:
+        beads with Area = A / (2 n); raises :class:`TilingUnavailable` if they would be too long."""
+        return cls(bead_half_length(region.area_m2, n, rho_m), rho_m, region.width_m, region.height_m)
+
     @property
     def row_spacing_m(self) -> float:
         """h: distance between row axes (half the bead thickness)."""

@@ -9,7 +9,7 @@ from hypothesis import strategies as st
 
 from conftest import assert_valid_tour
 from dtsp_mission.planning import get_planner, planners
-from dtsp_mission.planning.headings import closed_length_m
+from dtsp_mission.planning.headings import closed_length_m, leg_lengths_m
 from dtsp_mission.planning.lanes import (lane_headings, lane_sequence, looped_edges,
                                          repaired_lanes, visiting_order)
 from dtsp_mission.planning.lower_bounds import stochastic_lower_bound
@@ -84,7 +84,7 @@ def test_repair_moves_the_target_that_forces_a_loop_to_the_next_lane():
     order, direction = visiting_order(targets[:, 0], lanes, 2)
     points = targets[order]
     headings = lane_headings(points, direction, 100.0, math.radians(30))
-    loops = looped_edges(points, headings, lanes[order], 100.0)
+    loops = looped_edges(points, leg_lengths_m(points, headings, 100.0), lanes[order], 100.0)
     assert list(order[loops]) == [2]
     repaired = repaired_lanes(lanes, targets[:, 1], 20.0, order, loops, 12)
     # Target 2 is nearer its lane's edge, but that edge is the region's: target 3 moves up.

@@ -86,8 +86,7 @@ def kml_document(mission: Mission) -> ET.Element:
 
     target_folder = ET.SubElement(document, "Folder")
     _text(target_folder, "name", "Targets")
-    visit_rank = np.empty(len(tour.targets_m), dtype=int)
-    visit_rank[np.argsort(mission.path.target_s_m, kind="stable")] = np.arange(len(visit_rank))
+    visit_rank = mission.visit_numbers
     for target, item_index in enumerate(mission.target_items):
         item = mission.items[item_index]
         name = mission.target_names[target] if mission.target_names is not None else f"T{target}"
