@@ -4,6 +4,7 @@ from __future__ import annotations
 
 import numpy as np
 
+from ..errors import DtspError
 from ..tour import Tour
 from .alternating import AlternatingPlanner
 from .base import Planner
@@ -25,6 +26,7 @@ class AutoPlanner(Planner):
     def _plan(self, targets_m: np.ndarray, rho_m: float, region: Region | None) -> Tour:
         candidates: dict[str, float | str] = {}
         best: Tour | None = None
+        failures: list[DtspError] = []
         for planner in (AlternatingPlanner(), HeadingsPlanner(), LanesPlanner(),
                         RBTAPlanner(**self.parameters)):
             try:
@@ -32,10 +34,15 @@ class AutoPlanner(Planner):
             except TilingUnavailable as error:
                 candidates[planner.name] = f"not applicable: {error}"
                 continue
+            except DtspError as error:     # a peer's failure is reported, never fatal
+                candidates[planner.name] = f"failed: {error}"
+                failures.append(error)
+                continue
             candidates[planner.name] = tour.length_m
             if best is None or tour.length_m < best.length_m:
                 best = tour
-        assert best is not None
+        if best is None:
+            raise failures[0]
         report = dict(best.report, chosen=best.planner, candidates=candidates)
         return Tour(best.chain, best.rho_m, best.targets_m, best.visit_s_m,
                     f"auto ({best.planner})", dict(self.parameters), report)

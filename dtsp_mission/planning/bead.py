@@ -20,6 +20,8 @@ import numpy as np
 
 from ..segments import SegmentChain
 
+#: Points this close (in rho) to a bead's boundary belong to the bead (rounding).
+BOUNDARY_SLACK_RHO = 1e-12
 #: Radii beyond this many rho are treated as a straight line (height below 1e-12 l^2 / rho).
 STRAIGHT_RADIUS_RHO = 1e12
 _BISECTION_STEPS = 200
@@ -71,11 +73,12 @@ def curve_height(x_m: np.ndarray, l_m: float, radius_m: np.ndarray | float) -> n
 
 def contains(points_m: np.ndarray, l_m: float, rho_m: float) -> np.ndarray:
     """Whether each point (bead frame, shape (..., 2)) lies in the closed bead B_rho(l), with a
-    slack of 1e-12 rho for points on the boundary (rounding of integrated paths)."""
+    slack of :data:`BOUNDARY_SLACK_RHO` rho for points on the boundary (rounding of integrated
+    paths)."""
     _check(l_m, rho_m)
     points = np.asarray(points_m, dtype=float)
     x, y = points[..., 0], points[..., 1]
-    slack = 1e-12 * rho_m
+    slack = BOUNDARY_SLACK_RHO * rho_m
     inside_x = np.abs(x) <= l_m + slack
     height = curve_height(np.clip(x, -l_m, l_m), l_m, rho_m)
     return inside_x & (np.abs(y) <= height + slack)

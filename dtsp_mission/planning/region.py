@@ -38,6 +38,11 @@ class Region:
     def area_m2(self) -> float:
         return self.width_m * self.height_m
 
+    def moved(self, offset_m: np.ndarray) -> "Region":
+        """The same rectangle translated by ``offset_m`` (x, y)."""
+        return Region(self.x_m + float(offset_m[0]), self.y_m + float(offset_m[1]), self.width_m,
+                      self.height_m, self.heading_rad)
+
     def to_local(self, points_m: np.ndarray) -> np.ndarray:
         """Points in the rectangle's frame (corner at the origin, width along +x)."""
         c, s = np.cos(self.heading_rad), np.sin(self.heading_rad)

@@ -31,14 +31,17 @@ class TilingUnavailable(InputError):
 def bead_half_length(area_m2: float, n: int, rho_m: float) -> float:
     """The l with Area[B_rho(l)] = A / (2 n), solved exactly (the paper's bead size)."""
     wanted = area_m2 / (2.0 * n)
-    largest = 8.0 * rho_m * rho_m                     # Area[B_rho(2 rho)] = 2 rho * 4 rho
-    if wanted > largest:
-        minimum_n = int(np.ceil(area_m2 / (2.0 * largest)))
+    top = 2.0 * rho_m
+    largest = bead.area(top, rho_m)             # 8 rho^2 up to rounding: the area is computed
+    if wanted > largest * (1.0 + 1e-12):        # the same way here as in the root finder
+        minimum_n = int(np.ceil(area_m2 / (2.0 * largest * (1.0 + 1e-12))))
         raise TilingUnavailable(
             f"the bead tiling needs at least {minimum_n} targets for this region and radius "
             f"(area {area_m2:.4g} m^2, rho {rho_m:g} m; {n} given): with fewer, a bead would be "
             f"longer than 4 rho")
-    return float(brentq(lambda l: bead.area(l, rho_m) - wanted, 1e-300, 2.0 * rho_m,
+    if wanted >= largest:                       # on the boundary: the largest bead
+        return top
+    return float(brentq(lambda l: bead.area(l, rho_m) - wanted, 1e-300, top,
                         xtol=1e-15 * rho_m, rtol=1e-15, maxiter=500))
 
 
@@ -72,8 +75,10 @@ class BeadTiling:
 
     @property
     def row_count(self) -> int:
-        """Rows 0..K whose beads meet the rectangle."""
-        return int(np.ceil(self.height_m / self.row_spacing_m - 1e-12)) + 1
+        """Rows 0..K whose beads meet the rectangle: every row :meth:`bead_of` gives a point of
+        the rectangle (both use the same boundary slack)."""
+        slack = bead.BOUNDARY_SLACK_RHO * self.rho_m
+        return int(np.ceil(max(self.height_m - slack, 0.0) / self.row_spacing_m)) + 1
 
     def bead_of(self, points_m: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
         """Row ``k`` and index ``m`` along the row of the bead holding each point."""
@@ -82,7 +87,8 @@ class BeadTiling:
         k = np.floor(points[:, 1] / h).astype(np.int64)
         m = np.round((points[:, 0] / l - (k % 2)) / 2.0).astype(np.int64)
         dx = points[:, 0] - (2 * m + (k % 2)) * l
-        in_lower = (points[:, 1] - k * h) <= bead.curve_height(np.clip(dx, -l, l), l, self.rho_m)
+        in_lower = ((points[:, 1] - k * h) <= bead.curve_height(np.clip(dx, -l, l), l, self.rho_m)
+                    + bead.BOUNDARY_SLACK_RHO * self.rho_m)
         k_up = k + 1
         m_up = np.round((points[:, 0] / l - (k_up % 2)) / 2.0).astype(np.int64)
         return np.where(in_lower, k, k_up), np.where(in_lower, m, m_up)

@@ -6,6 +6,7 @@ from dataclasses import dataclass, replace
 from typing import TYPE_CHECKING
 
 import numpy as np
+from scipy.spatial import cKDTree
 
 from ..errors import InputError
 
@@ -81,11 +82,35 @@ def check_altitudes(altitudes_m: np.ndarray | None, where: str) -> None:
                          "a number above 0 (metres above home)")
 
 
+def cluster_positions(positions: np.ndarray, resolution: float = 0.0) -> tuple[np.ndarray, np.ndarray]:
+    """Group positions closer than ``resolution`` (``0``: exactly equal).
+
+    Returns ``keep``, the indices (in input order) of the positions that stand for a group, and
+    ``leader``, for every position the index into ``keep`` of the one standing for it.  Every
+    position lies within ``resolution`` of its leader, and the first position of a group leads.
+    """
+    points = np.asarray(positions, dtype=float)
+    points = points.reshape(len(points), points.shape[-1] if points.ndim > 1 else 1)
+    n = len(points)
+    lead = np.arange(n)
+    if n > 1:
+        pairs = cKDTree(points).query_pairs(float(resolution), output_type="ndarray")
+        if len(pairs):
+            pairs = np.sort(pairs, axis=1)
+            pairs = pairs[np.lexsort((pairs[:, 1], pairs[:, 0]))]
+            for i, j in pairs:        # i < j, in input order: a leader is never led
+                if lead[i] == i and lead[j] == j:
+                    lead[j] = i
+    keep = np.flatnonzero(lead == np.arange(n))
+    index_in_keep = np.empty(n, dtype=np.int64)
+    index_in_keep[keep] = np.arange(len(keep))
+    return keep, index_in_keep[lead]
+
+
 def merge_duplicates(positions: np.ndarray) -> tuple[np.ndarray, int]:
     """Indices (in input order) of the first target at each distinct position, and how many
     were dropped.  ``positions`` is any (n, 2) coordinate array; equality is exact."""
-    _, first = np.unique(np.asarray(positions, dtype=float), axis=0, return_index=True)
-    keep = np.sort(first)
+    keep, _ = cluster_positions(positions)
     return keep, len(positions) - len(keep)
 
 

@@ -8,7 +8,11 @@ A tour is valid when (all measured, none assumed):
   start pose of the next one (the last meets the first) within ``tolerance_rho * rho`` in
   position and ``tolerance_rho`` radians in heading;
 * every target has a visit whose arc length lies on the tour and whose pose there is within
-  ``tolerance_rho * rho`` of the target.
+  ``tolerance_rho * rho`` of the target;
+* the invariants no rounding can fake: a closed tour is at least one full circle long
+  (``2 pi rho``: no closed curve of curvature at most ``1 / rho`` is shorter) and turns a whole
+  number of times in total, and no part of the path between two consecutive visits is shorter
+  than the exact Dubins distance between their visit poses.
 """
 
 from __future__ import annotations
@@ -17,6 +21,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from ..dubins import shortest_length
 from ..errors import TourInvalidError
 from ..segments import SegmentChain, wrap_angle
 from .model import Tour
@@ -129,5 +134,40 @@ def check_path(chain: SegmentChain, rho_m: float, targets_m: np.ndarray, visit_s
             first = int(np.argmax(missed))
             problems.append(f"{int(missed.sum())} targets are not on the path (first: target "
                             f"{first}, missed by {misses[first]:.3g} m)")
+    if len(chain) and finite and np.isfinite(rho):
+        problems.extend(_invariant_problems(chain, rho, tolerance_m, visits if len(targets_m) else
+                                            np.zeros(0), closed, max_heading * len(chain)))
     return CheckReport(tuple(problems), len(chain), len(targets_m), chain.length_m,
                        max_gap, max_heading, max_curvature_ratio, max_miss)
+
+
+def _invariant_problems(chain: SegmentChain, rho: float, tolerance_m: float, visits: np.ndarray,
+                        closed: bool, heading_slack_rad: float) -> list[str]:
+    """Violations of the invariants that hold for every feasible path (module docstring)."""
+    problems = []
+    length = chain.length_m
+    if closed and length < 2.0 * np.pi * rho - tolerance_m:
+        problems.append(f"a closed path of curvature <= 1/rho is at least 2 pi rho = "
+                        f"{2 * np.pi * rho:.6g} m long; this one is {length:.6g} m")
+    if closed:
+        turning = float(np.sum(chain.curvatures_1_m * chain.lengths_m))
+        turns = turning / (2.0 * np.pi)
+        off = abs(turns - round(turns)) * 2.0 * np.pi
+        if off > max(TOLERANCE_RHO, heading_slack_rad) + 1e-12 * len(chain):
+            problems.append(f"the total turning is {turns:.9f} turns, not a whole number")
+    usable = np.isfinite(visits) & (visits >= 0) & (visits <= length + tolerance_m)
+    s = np.sort(np.clip(visits[usable], 0.0, length))
+    if len(s) >= 2 or (closed and len(s) == 1):
+        poses = chain.pose_at(s)
+        following = np.roll(poses, -1, axis=0)
+        along = np.diff(s, append=s[0] + length)
+        if not closed:
+            poses, following, along = poses[:-1], following[:-1], along[:-1]
+        shortest = shortest_length(poses, following, rho)
+        short = along < shortest - 2.0 * tolerance_m - 1e-9 * shortest
+        if short.any():
+            first = int(np.argmax(short))
+            problems.append(f"{int(short.sum())} legs between consecutive visits are shorter than "
+                            f"the exact Dubins distance between their poses (first: visit {first}, "
+                            f"{along[first]:.6g} m against {shortest[first]:.6g} m)")
+    return problems
