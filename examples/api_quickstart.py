@@ -16,7 +16,7 @@ from dtsp_mission.api import plan_mission
 from dtsp_mission.export import exporter_for
 from dtsp_mission.mission import MissionSettings
 from dtsp_mission.planning.lower_bounds import lower_bound
-from dtsp_mission.sim.flight import Airframe
+from dtsp_mission.autopilot.navigation import Airframe
 from dtsp_mission.sim.vehicle import SimulatedVehicle, VehicleSettings
 from dtsp_mission.targets import GeoTargets
 from dtsp_mission.upload import download_mission, to_wire, upload_mission

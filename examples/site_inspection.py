@@ -21,7 +21,7 @@ from dtsp_mission.api import plan_mission
 from dtsp_mission.export import exporter_for, exporters
 from dtsp_mission.mission import MissionSettings
 from dtsp_mission.plugins import working
-from dtsp_mission.sim.flight import Airframe
+from dtsp_mission.autopilot.navigation import Airframe
 from dtsp_mission.sim.fly import fly_mission, targets_in
 from dtsp_mission.targets import read_targets
 
@@ -56,8 +56,8 @@ def main() -> None:
         vehicle_mission = mission.for_vehicle()
         check = fly_mission(vehicle_mission, targets_in(vehicle_mission, mission.target_names),
                             Airframe(AIRSPEED_M_S, AIRCRAFT_MIN_TURN_M, l1_period_s=5.0,
-                                     roll_time_constant_s=0.3),
-                            speedup=args.speedup)
+                                     roll_natural_rad_s=6.0, roll_damping=0.8),
+                            speedup=args.speedup, max_items=4000)     # SD storage, as planned
         worst = int(np.argmax(check.miss_m))
         print(f"flown: completed {check.completed}, {check.items_reached}/{check.items} items, "
               f"{check.flight_time_s / 60:.1f} min; miss median {np.median(check.miss_m):.2f} m, "

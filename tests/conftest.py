@@ -86,13 +86,14 @@ def mavsdk_mission_raw():
 def start_vehicle():
     """``start_vehicle(mission, **settings)``: a simulated vehicle at the mission's home on a
     free loopback port, stopped when the test ends."""
-    from dtsp_mission.sim.flight import Airframe
+    from dtsp_mission.autopilot.navigation import Airframe
     from dtsp_mission.sim.vehicle import SimulatedVehicle, VehicleSettings
     started = []
 
     def start(mission, **settings):
         settings.setdefault("airframe", Airframe(20.0, 80.0))
-        vehicle = SimulatedVehicle(VehicleSettings(mission.home, mission.autopilot, **settings))
+        settings.setdefault("autopilot", mission.autopilot)
+        vehicle = SimulatedVehicle(VehicleSettings(mission.home, **settings))
         started.append(vehicle.start())
         return vehicle
 

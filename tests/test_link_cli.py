@@ -13,6 +13,7 @@ import pytest
 from click.testing import CliRunner
 
 from conftest import free_udp_port, make_mission
+from dtsp_mission.autopilot import Autopilot
 from dtsp_mission.cli.main import cli
 from dtsp_mission.export import exporter_for
 from dtsp_mission.upload.wire import differences, to_wire
@@ -66,14 +67,16 @@ def test_fly_command_reports_every_target(mission, tmp_path):
     assert result.exit_code == 0, result.output
     assert "simulated flight completed" in result.output
     rows = re.findall(r"^item \d+\t([\d.]+)\t", result.output, re.M)
-    assert len(rows) == 8 and max(map(float, rows)) <= 20.0
+    # A stock ArduPlane flies the chords of these waypoint missions 10-40 m off the targets
+    # (the recorded SITL flights); the model predicts the same.
+    assert len(rows) == 8 and max(map(float, rows)) <= 40.0
     strict = run("fly", path, "--radius", 80, "--airspeed", 20, "--speedup", 400,
                  "--max-miss", 0.001)
     assert strict.exit_code == 1 and "missed by" in strict.output
 
 
 def test_plan_simulate_and_upload_in_one_go(tmp_path, start_vehicle, mission):
-    vehicle = start_vehicle(mission)       # any home: the vehicle takes what it is sent
+    vehicle = start_vehicle(mission, max_items=4000)   # with SD storage: the site needs ~1,800 items
     out = tmp_path / "site.plan"
     result = run("plan", SITE, "--radius", 80, "--alt", 120, "--airspeed", 22, "--max-items",
                  4000, "-o", out, "--upload", f"udpout:127.0.0.1:{vehicle.port}")
@@ -109,7 +112,7 @@ def test_upload_a_tour_json_builds_the_mission_with_plan_options(tmp_path, start
     tour = tmp_path / "tour.json"
     result = run("plan", SITE, "--radius", 80, "--max-items", 4000, "-o", tour)
     assert result.exit_code == 0, result.output
-    vehicle = start_vehicle(mission)
+    vehicle = start_vehicle(mission, max_items=4000, autopilot=Autopilot.PX4)   # with SD storage
     result = run("upload", tour, "--connect", f"udpout:127.0.0.1:{vehicle.port}",
                  "--max-items", 4000, "--alt", 150, "--autopilot", "px4")
     assert result.exit_code == 0, result.output

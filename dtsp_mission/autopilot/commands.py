@@ -13,7 +13,9 @@ class Command(IntEnum):
     """MAV_CMD values."""
 
     NAV_WAYPOINT = 16
+    NAV_LOITER_UNLIM = 17
     NAV_LOITER_TURNS = 18
+    NAV_LOITER_TIME = 19
     NAV_RETURN_TO_LAUNCH = 20
     NAV_LAND = 21
     NAV_TAKEOFF = 22
@@ -27,6 +29,10 @@ class Frame(IntEnum):
     GLOBAL = 0
     MISSION = 2
     GLOBAL_RELATIVE_ALT = 3
+    GLOBAL_INT = 5
+    GLOBAL_RELATIVE_ALT_INT = 6
+    GLOBAL_TERRAIN_ALT = 10
+    GLOBAL_TERRAIN_ALT_INT = 11
 
 
 class Autopilot(IntEnum):

@@ -12,12 +12,12 @@ from .sim_command import airframe_from
 
 
 def run_flight_check(mission, targets, airframe, via: str, speedup: float,
-                     max_miss_m: float | None) -> FlightCheck:
+                     max_miss_m: float | None, max_items: int | None = None) -> FlightCheck:
     """Fly, print the report, and fail (exit 1) when ``max_miss_m`` is exceeded (shared with
     ``plan --simulate``)."""
     progress, close = progress_reporter("flying")
     try:
-        check = fly_mission(mission, targets, airframe, via=via, speedup=speedup,
+        check = fly_mission(mission, targets, airframe, via=via, speedup=speedup, max_items=max_items,
                             progress=lambda stage, done, total: progress(done, total)
                             if stage == "flight" else None)
     finally:
@@ -54,18 +54,22 @@ def print_check(check: FlightCheck) -> None:
 @click.option("--format", "format_name", help="Format of MISSION_FILE, whatever its extension.")
 @click.option("--max-miss", "max_miss_m", type=float, metavar="METRES",
               help="Exit with status 1 if any target is missed by more than this.")
+@click.option("--max-items", type=int, metavar="N", help="Mission slots of the simulated "
+              "vehicle (default: a stock vehicle's, ArduPlane 655, PX4 500).")
 @reports_errors
-def fly(mission_file, rho_m, airspeed_m_s, max_bank_deg, speedup, l1_period_s, via,
-        format_name, max_miss_m) -> None:
+def fly(mission_file, rho_m, airspeed_m_s, max_bank_deg, speedup, vehicle_params_file,
+        l1_period_s, via, format_name, max_miss_m, max_items) -> None:
     """Upload MISSION_FILE to the simulated fixed wing, fly it, and print per-target miss
     distances and the flight time.
 
     The targets are the waypoints with an acceptance radius (how dtsp-mission writes them).
-    The aircraft turns no tighter than --radius (or --airspeed with --max-bank).
+    The aircraft navigates like an ArduPlane with --vehicle-params (a stock one without);
+    --radius or --max-bank limit its bank, --airspeed sets its cruise speed.
 
     Example: dtsp-mission fly mission.plan --radius 80 --airspeed 22
     """
     from ..export import read_mission
     mission = read_mission(mission_file, format_name)
-    airframe, _ = airframe_from(rho_m, airspeed_m_s, max_bank_deg, l1_period_s)
-    run_flight_check(mission, targets_in(mission), airframe, via, speedup, max_miss_m)
+    airframe, _, _ = airframe_from(vehicle_params_file, airspeed_m_s, max_bank_deg, l1_period_s,
+                                   rho_m)
+    run_flight_check(mission, targets_in(mission), airframe, via, speedup, max_miss_m, max_items)

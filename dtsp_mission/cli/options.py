@@ -151,9 +151,14 @@ link_options = [
 simulation_options = [
     click.option("--speedup", type=float, default=50.0, show_default=True,
                  help="Simulated seconds per wall-clock second (0: as fast as possible)."),
-    click.option("--l1-period", "l1_period_s", type=float, default=8.0, show_default=True,
-                 metavar="S", help="L1 navigation period of the simulated autopilot "
-                                   "(ArduPlane's NAVL1_PERIOD; its default is 17)."),
+    click.option("--vehicle-params", "vehicle_params_file", type=click.Path(dir_okay=False),
+                 metavar="FILE.parm", help="The vehicle's parameters (NAME VALUE lines, as "
+                 "ArduPilot and MAVProxy write them): the flight model navigates with its "
+                 "NAVL1_*, WP_RADIUS, ROLL_LIMIT_DEG, AIRSPEED_CRUISE, TECS_*; default a stock "
+                 "ArduPlane's."),
+    click.option("--l1-period", "l1_period_s", type=float, metavar="S",
+                 help="Override NAVL1_PERIOD, the L1 navigation period of the simulated "
+                      "autopilot."),
 ]
 
 

@@ -13,6 +13,7 @@ from ..export import exporter_for
 from ..frame import LocalFrame
 from ..mission import Autopilot, build_mission
 from ..planning import TilingUnavailable, get_planner, planners
+from ..planning.base import MERGE_RESOLUTION_RHO
 from ..planning.lower_bounds import lower_bound
 from ..plot import draw_plan, require_matplotlib
 from ..targets import GeoTargets, Targets, random_targets, read_targets
@@ -100,8 +101,8 @@ def _duration(seconds: float) -> str:
               help="Upload the mission to this vehicle after writing the files "
                    "(udpout:HOST:PORT, ...); see `dtsp-mission upload`.")
 @apply(link_options)
-@click.option("--simulate", is_flag=True, help="Fly the mission in the simulator (an aircraft "
-              "turning no tighter than rho) and print per-target miss distances.")
+@click.option("--simulate", is_flag=True, help="Fly the mission in the simulator (an ArduPlane "
+              "with --vehicle-params, stock without) and print per-target miss distances.")
 @apply(simulation_options)
 @click.option("--max-miss", "max_miss_m", type=float, metavar="METRES",
               help="With --simulate: exit with status 1 if a target is missed by more than this.")
@@ -109,8 +110,8 @@ def _duration(seconds: float) -> str:
 def plan(targets_file, random_count, area_file, seed, origin, rho_m, airspeed_m_s, max_bank_deg,
          altitude_m, home_deg, home_amsl_m, launch_bearing_deg, landing_bearing_deg, autopilot,
          return_mode, tolerance_m, max_items, algorithm, region, fallback, outputs, format_name,
-         plot_file, connection, via, verify, signing_key_file, simulate, speedup, l1_period_s,
-         max_miss_m) -> None:
+         plot_file, connection, via, verify, signing_key_file, simulate, speedup, vehicle_params_file,
+         l1_period_s, max_miss_m) -> None:
     """Plan a Dubins tour through the targets and write it as a mission.
 
     TARGETS_FILE: CSV with lat,lon columns (optional alt, name), or local x,y metres (with
@@ -178,12 +179,22 @@ def plan(targets_file, random_count, area_file, seed, origin, rho_m, airspeed_m_
         from ..sim.fly import targets_in
         from .fly_command import run_flight_check
         from .sim_command import airframe_from
-        airframe, _ = airframe_from(rho, airspeed_m_s, None, l1_period_s)
+        airframe, _, _ = airframe_from(vehicle_params_file, airspeed_m_s, None, l1_period_s)
         mission = product.for_vehicle()
-        run_flight_check(mission, targets_in(mission, product.target_names), airframe, via, speedup, max_miss_m)
+        run_flight_check(mission, targets_in(mission, product.target_names), airframe, via,
+                         speedup, max_miss_m, max_items)
     if connection:
         from .upload_command import run_upload
-        run_upload(product.for_vehicle(), connection, via, verify, signing_key_file)
+        run_upload(product.for_vehicle(), connection, via, verify, signing_key_file,
+                   designed_for=_designed_for(vehicle_params_file))
+
+
+def _designed_for(vehicle_params_file):
+    """The parameters a mission is designed for: the file's, or None (a stock vehicle's)."""
+    if not vehicle_params_file:
+        return None
+    from ..autopilot.parameters import read_parameters
+    return read_parameters(vehicle_params_file)
 
 
 def _report_tour(tour, positions: np.ndarray, area_m: np.ndarray | None, elapsed: float) -> None:
@@ -193,6 +204,9 @@ def _report_tour(tour, positions: np.ndarray, area_m: np.ndarray | None, elapsed
         area = max(float(np.ptp(positions[:, 0]) * np.ptp(positions[:, 1])), 1.0)
     bound = lower_bound(positions, tour.rho_m, area)
     click.echo(f"planner {tour.planner}: tour {tour.length_m:,.1f} m ({elapsed:.2f} s)")
+    if tour.report.get("merged_targets"):
+        click.echo(f"note: {tour.report['merged_targets']} targets lie within "
+                   f"{MERGE_RESOLUTION_RHO:g} rho of another and are visited as one", err=True)
     click.echo(f"  certified lower bound (1-tree) {bound.one_tree_m:,.1f} m: ratio "
                f"{tour.length_m / bound.one_tree_m:.3f}; estimate for uniform targets "
                f"{bound.stochastic_m:,.1f} m: ratio {tour.length_m / bound.stochastic_m:.3f}")

@@ -8,21 +8,44 @@ import click
 
 from ..mission import AUTOPILOTS
 from ..mission.model import Home
-from ..sim.flight import Airframe
+from dataclasses import replace
+
+from ..autopilot.navigation import Airframe
+from ..autopilot.parameters import ARDUPLANE_DEFAULTS, VehicleParameters, read_parameters
+from ..vehicle import bank_for_radius_deg
 from ..sim.vehicle import SimulatedVehicle, VehicleSettings
 from ..upload.connection import read_signing_key
 from .options import (LAT_LON, UserError, apply, reports_errors, simulation_options,
                       turn_radius_from, vehicle_options)
 
 
-def airframe_from(rho_m, airspeed_m_s, max_bank_deg, l1_period_s) -> tuple[Airframe, str]:
-    """The simulated airframe from the vehicle options (airspeed default 20 m/s)."""
-    rho, source = turn_radius_from(rho_m, airspeed_m_s, max_bank_deg)
-    if not rho > 0:
-        raise UserError(f"the turn radius must be above 0 m, got {rho:g}")
-    if not l1_period_s > 0:
-        raise UserError(f"--l1-period must be above 0 s, got {l1_period_s:g}")
-    return Airframe(airspeed_m_s or 20.0, rho, l1_period_s), source
+def airframe_from(vehicle_params_file, airspeed_m_s, max_bank_deg, l1_period_s,
+                  rho_m=None) -> tuple[Airframe, VehicleParameters, str]:
+    """The simulated aircraft: an ArduPlane with the parameters of ``vehicle_params_file``
+    (a stock one without), overridden by the options given: ``--airspeed`` (cruise),
+    ``--max-bank`` (roll limit), ``--radius`` (a roll limit that turns no tighter than it),
+    ``--l1-period``."""
+    parameters = read_parameters(vehicle_params_file) if vehicle_params_file else ARDUPLANE_DEFAULTS
+    if airspeed_m_s is not None:
+        if not airspeed_m_s > 0:
+            raise UserError(f"--airspeed must be above 0 m/s, got {airspeed_m_s:g}")
+        parameters = replace(parameters, AIRSPEED_CRUISE=airspeed_m_s)
+    if l1_period_s is not None:
+        if not l1_period_s > 0:
+            raise UserError(f"--l1-period must be above 0 s, got {l1_period_s:g}")
+        parameters = replace(parameters, NAVL1_PERIOD=l1_period_s)
+    if max_bank_deg is not None or rho_m is not None:
+        if max_bank_deg is None:
+            if not rho_m > 0:
+                raise UserError(f"the turn radius must be above 0 m, got {rho_m:g}")
+            max_bank_deg = bank_for_radius_deg(parameters.AIRSPEED_CRUISE, rho_m)
+        if not 0 < max_bank_deg < 90:
+            raise UserError(f"--max-bank must be between 0 and 90 deg, got {max_bank_deg:g}")
+        parameters = replace(parameters, ROLL_LIMIT_DEG=max_bank_deg)
+    source = (f"ArduPlane navigation: {'parameters from ' + str(vehicle_params_file) if vehicle_params_file else 'stock parameters'}, "
+              f"cruise {parameters.AIRSPEED_CRUISE:g} m/s, roll limit {parameters.ROLL_LIMIT_DEG:.0f} deg, "
+              f"NAVL1_PERIOD {parameters.NAVL1_PERIOD:g} s, WP_RADIUS {parameters.WP_RADIUS:g} m")
+    return Airframe.from_parameters(parameters), parameters, source
 
 
 @click.command()
@@ -39,23 +62,26 @@ def airframe_from(rho_m, airspeed_m_s, max_bank_deg, l1_period_s) -> tuple[Airfr
 @apply(vehicle_options)
 @apply(simulation_options)
 @click.option("--max-items", type=int, metavar="N",
-              help="Mission slots; a longer upload gets MAV_MISSION_NO_SPACE.")
+              help="Mission slots (home included on ArduPilot); a longer upload gets "
+                   "MAV_MISSION_NO_SPACE.  Default: a stock vehicle's (ArduPlane 655, PX4 500).")
 @click.option("--signing-key", "signing_key_file", type=click.Path(dir_okay=False),
               metavar="FILE", help="Accept only messages signed with this MAVLink 2 key.")
 @click.option("--autostart", is_flag=True, help="Fly as soon as a mission arrives (otherwise on "
               "MAV_CMD_MISSION_START).")
 @reports_errors
 def sim(listen, gcs, home_deg, home_amsl_m, autopilot, rho_m, airspeed_m_s, max_bank_deg,
-        speedup, l1_period_s, max_items, signing_key_file, autostart) -> None:
+        speedup, vehicle_params_file, l1_period_s, max_items, signing_key_file, autostart) -> None:
     """Run a simulated fixed-wing vehicle that accepts missions over MAVLink and flies them.
 
     Example: dtsp-mission sim --home 46.805,6.941 --radius 80 --airspeed 22 --autostart
     """
-    airframe, source = airframe_from(rho_m, airspeed_m_s, max_bank_deg, l1_period_s)
+    airframe, parameters, source = airframe_from(vehicle_params_file, airspeed_m_s, max_bank_deg,
+                                                 l1_period_s, rho_m)
     host, port = _address(listen)
     settings = VehicleSettings(Home(*home_deg, home_amsl_m), AUTOPILOTS[autopilot], airframe,
                                speedup, max_items=max_items, autostart=autostart,
-                               signing_key=read_signing_key(signing_key_file) if signing_key_file else None)
+                               signing_key=read_signing_key(signing_key_file) if signing_key_file else None,
+                               parameters=parameters)
     try:
         vehicle = SimulatedVehicle(settings, port, host, _address(gcs) if gcs else None)
     except OSError as error:

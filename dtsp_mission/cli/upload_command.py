@@ -11,16 +11,19 @@ from .options import (UserError, apply, link_options, mission_options, mission_s
 
 
 def run_upload(mission, connection: str, via: str, verify: bool, signing_key_file: str | None,
-               heartbeat_timeout_s: float | None = None) -> None:
+               heartbeat_timeout_s: float | None = None, designed_for=None) -> None:
     """Upload with a progress bar and print what happened (shared with ``plan --upload``)."""
     key = read_signing_key(signing_key_file) if signing_key_file else None
     progress, close = progress_reporter("uploading")
     click.echo(f"uploading {len(mission.items)} mission items to {connection} via {via}")
     try:
         report = upload_mission(mission, connection, via=via, verify=verify, signing_key=key,
-                                progress=progress, heartbeat_timeout_s=heartbeat_timeout_s)
+                                progress=progress, heartbeat_timeout_s=heartbeat_timeout_s,
+                                designed_for=designed_for)
     finally:
         close()
+    for warning in report.warnings:
+        click.echo(f"warning: {warning}", err=True)
     line = (f"the vehicle accepted {report.items} items in {report.seconds:.2f} s "
             f"({report.resent} resent)")
     click.echo(line + ("; downloaded back: it holds exactly the planned mission" if report.verified
@@ -40,17 +43,23 @@ def run_upload(mission, connection: str, via: str, verify: bool, signing_key_fil
               show_default=True, metavar="S", help="How long to wait for the vehicle.")
 @apply(mission_options)
 @vehicle_options[1]        # --airspeed, for the tour's mission
+@click.option("--vehicle-params", "vehicle_params_file", type=click.Path(dir_okay=False),
+              metavar="FILE.parm", help="The parameters the mission was designed for; each "
+              "navigation parameter the vehicle has otherwise is warned about (default: a "
+              "stock ArduPlane's).")
 @reports_errors
 def upload(mission_file, connection, via, verify, signing_key_file, format_name,
-           heartbeat_timeout_s, **mission_option_values) -> None:
+           heartbeat_timeout_s, vehicle_params_file, **mission_option_values) -> None:
     """Upload MISSION_FILE (.plan, .waypoints, or a tour .json) to a vehicle over MAVLink.
 
     A tour .json (from `plan -o tour.json`, with its frame origin) becomes a mission here,
     with the same options as `plan` (--alt, --autopilot, --return, ...); .plan and
     .waypoints files are sent as they are.
 
-    After the upload the mission is downloaded back and compared item by item (ArduPilot
-    uploads are not atomic); on any failure the message says what the vehicle holds.
+    Before it, the vehicle's autopilot must be the plan's (ArduPilot or PX4), and its
+    navigation parameters and home are compared with the plan's (warnings).  After the upload
+    the mission is downloaded back and compared item by item, as the autopilot stores items
+    (ArduPilot uploads are not atomic); on any failure the message says what the vehicle holds.
 
     Example: dtsp-mission upload mission.plan --connect udpout:127.0.0.1:14550
     """
@@ -59,7 +68,9 @@ def upload(mission_file, connection, via, verify, signing_key_file, format_name,
         mission = _tour_mission(mission_file, mission_settings(**mission_option_values))
     else:
         mission = read_mission(mission_file, format_name)
-    run_upload(mission, connection, via, verify, signing_key_file, heartbeat_timeout_s)
+    from .plan_command import _designed_for
+    run_upload(mission, connection, via, verify, signing_key_file, heartbeat_timeout_s,
+               _designed_for(vehicle_params_file))
 
 
 def _tour_mission(path, settings):

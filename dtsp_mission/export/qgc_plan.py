@@ -16,7 +16,7 @@ from typing import Any
 from ..errors import FileFormatError, TourInvalidError
 from ..files import read_text
 from ..mission import Autopilot, Home, Mission, MissionItem, VehicleMission
-from ..mission.commands import VEHICLE_TYPE_FIXED_WING
+from ..autopilot.commands import VEHICLE_TYPE_FIXED_WING
 from .base import Exporter
 
 #: QGroundControl's default fixed-wing cruise speed, written when no airspeed is given (QGC

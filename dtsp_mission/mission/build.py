@@ -19,7 +19,7 @@ from ..frame import LocalFrame
 from ..targets import GeoTargets
 from ..tour import Tour
 from ..vehicle import bearing_to_heading_rad, heading_to_bearing_deg
-from .commands import AUTOPILOTS, Autopilot, Command, Frame
+from ..autopilot.commands import AUTOPILOTS, Autopilot, Command, Frame
 from .discretise import waypoint_s
 from .flight_path import TAKEOFF_CLIMB_DEG, climb_distance_m, plan_flight_path
 from .model import FlightPath, Home, Mission, MissionItem, waypoint

@@ -15,7 +15,7 @@ import numpy as np
 from ..frame import LocalFrame
 from ..segments import SegmentChain
 from ..tour import Tour
-from .commands import Autopilot, Command, Frame
+from ..autopilot.commands import Autopilot, Command, Frame
 
 
 def degrees_to_e7(degrees: float) -> int:

@@ -21,7 +21,7 @@ from ..errors import LinkError
 from ..mission import Command, VehicleMission
 from ..upload import UploadReport, upload_mission
 from ..upload.pymavlink_link import GCS_COMPONENT_ID, GCS_SYSTEM_ID, use_mavlink2
-from .flight import Airframe, closest_approach_m
+from ..autopilot.navigation import Airframe, closest_approach_m
 from .vehicle import MAV_CMD_MISSION_START, SimulatedVehicle, VehicleSettings
 
 
@@ -76,10 +76,11 @@ class FlightCheck:
 def fly_mission(mission: VehicleMission, targets: Targets, airframe: Airframe,
                 via: str = "pymavlink", speedup: float = 50.0, telemetry_hz: float = 10.0,
                 progress: Callable[[str, int, int], None] | None = None,
-                timeout_s: float | None = None) -> FlightCheck:
-    """Upload ``mission`` to a simulated vehicle with ``airframe``, fly it, and measure."""
+                timeout_s: float | None = None, max_items: int | None = None) -> FlightCheck:
+    """Upload ``mission`` to a simulated vehicle with ``airframe`` and ``max_items`` mission
+    slots (None: a stock vehicle's), fly it, and measure."""
     settings = VehicleSettings(mission.home, mission.autopilot, airframe, speedup,
-                               telemetry_hz=telemetry_hz)
+                               telemetry_hz=telemetry_hz, max_items=max_items)
     with SimulatedVehicle(settings) as vehicle:
         connection = f"udpout:127.0.0.1:{vehicle.port}"
         report = upload_mission(mission, connection, via=via,

@@ -1,5 +1,5 @@
 """A simulated fixed-wing vehicle that speaks MAVLink: MAVSDK's server plugins serve the
-mission protocol and telemetry, :class:`~dtsp_mission.sim.flight.MissionFlight` flies.
+mission protocol and telemetry, :class:`~dtsp_mission.autopilot.navigation.MissionFlight` flies.
 
 MAVSDK runs on a ``raw://`` connection; this module owns the UDP socket and sits between it
 and the ground station, adding what the server plugins do not do: a heartbeat as a fixed
@@ -19,24 +19,30 @@ from dataclasses import dataclass, field
 import numpy as np
 from pymavlink.dialects.v20 import common as mavlink2
 
+from ..autopilot.navigation import Airframe, LocalItem, MissionFlight, local_items
+from ..autopilot.parameters import ARDUPLANE_DEFAULTS, NAMES, VehicleParameters
+from ..autopilot.storage import capacity, stored_item
 from ..frame import LocalFrame
 from ..mavsdk_log import quiet_mavsdk_log
 from ..mission import Autopilot, Frame
 from ..mission.model import Home
 from ..upload.wire import WireItem, first_mission_seq
 from ..vehicle import heading_to_bearing_deg
-from .flight import Airframe, LocalItem, MissionFlight
 
 MAV_TYPE_FIXED_WING = 1
 MAV_CMD_MISSION_START = 300
+MAV_CMD_REQUEST_MESSAGE = 512
+MAVLINK_MSG_ID_HOME_POSITION = 242
+MAV_PARAM_TYPE_REAL32 = 9
 MAV_RESULT_ACCEPTED = 0
 MAV_RESULT_DENIED = 2
 MAV_MISSION_NO_SPACE = 4
+MAV_MISSION_INVALID_SEQUENCE = 13
 MAV_STATE_STANDBY, MAV_STATE_ACTIVE = 3, 4
 MAV_MODE_FLAG_CUSTOM_MODE_ENABLED = 1
 MAV_MODE_FLAG_AUTO_ENABLED = 4
 MAV_MODE_FLAG_SAFETY_ARMED = 128
-MAV_SEVERITY_ERROR = 3
+MAV_SEVERITY_WARNING = 4
 SIGNING_EPOCH_S = 1420070400     # MAVLink 2 signing timestamps count from 2015-01-01
 
 
@@ -50,11 +56,13 @@ class VehicleSettings:
     speedup: float = 50.0             # simulated seconds per wall second; 0: as fast as possible
     step_s: float = 0.05
     telemetry_hz: float = 10.0        # position messages per simulated second
-    max_items: int | None = None      # mission slots (home included on ArduPilot)
+    max_items: int | None = None      # mission slots (home included on ArduPilot); None: a
+                                      # stock vehicle's (ArduPlane 655, PX4 500)
     signing_key: bytes | None = None
     autostart: bool = False           # fly as soon as a mission arrives
     restart_at_item: int | None = None   # fault: reboot when this item arrives in an upload
     restart_s: float = 1.0            # how long a reboot keeps it silent (wall seconds)
+    parameters: VehicleParameters = ARDUPLANE_DEFAULTS   # what it answers PARAM_REQUEST_READ with
 
 
 @dataclass
@@ -99,7 +107,9 @@ class SimulatedVehicle:
         self._start_requested = False
         self._stop = threading.Event()
         self.finished = threading.Event()
-        self.mission: list[WireItem] = []     # the last mission the plugins accepted
+        self.mission: list[WireItem] = []     # the last mission the plugins accepted, as stored
+        self._stored = threading.Event()      # set while no accepted upload is pending
+        self._stored.set()
         self.uploads = 0
         self.restarts = 0
         self.log = FlightLog()
@@ -250,19 +260,40 @@ class SimulatedVehicle:
         """Answer what the plugins cannot; True when the message must not reach them."""
         kind = message.get_type()
         settings = self.settings
-        if kind == "MISSION_COUNT" and message.mission_type == 0 and settings.max_items is not None \
-                and message.count > settings.max_items:
+        slots = settings.max_items if settings.max_items is not None else capacity(settings.autopilot)
+        if kind == "MISSION_COUNT" and message.mission_type == 0 and message.count > slots:
             with self._link_lock:
                 self._encoder.srcSystem, self._encoder.srcComponent = 1, 1
                 self._encoder.statustext_send(
-                    MAV_SEVERITY_ERROR, f"Mission too long: {settings.max_items} items fit".encode())
+                    MAV_SEVERITY_WARNING, f"Only {slots} items are supported".encode())
                 self._encoder.mission_ack_send(message.get_srcSystem(), message.get_srcComponent(),
                                                MAV_MISSION_NO_SPACE, 0)
+            return True
+        if kind == "MISSION_COUNT" and message.mission_type == 0:
+            self._stored.clear()                # an upload begins: downloads wait for it
+        if kind in ("MISSION_REQUEST_LIST", "MISSION_REQUEST_INT", "MISSION_REQUEST", "MISSION_ACK") \
+                and getattr(message, "mission_type", 0) == 0:
+            self._serve_download(message)      # the vehicle's side of a download, from storage
             return True
         if kind == "MISSION_ITEM_INT" and settings.restart_at_item is not None \
                 and message.seq == settings.restart_at_item and not self._restart_done:
             self._restart_done = True
             threading.Thread(target=self.restart, daemon=True).start()
+            return True
+        if kind == "PARAM_REQUEST_READ":
+            self._answer_parameter(message)
+            return True
+        if kind == "COMMAND_LONG" and message.command == MAV_CMD_REQUEST_MESSAGE \
+                and int(message.param1) == MAVLINK_MSG_ID_HOME_POSITION:
+            home = settings.home
+            with self._link_lock:
+                self._encoder.srcSystem, self._encoder.srcComponent = 1, 1
+                self._encoder.command_ack_send(MAV_CMD_REQUEST_MESSAGE, MAV_RESULT_ACCEPTED, 0, 0,
+                                               message.get_srcSystem(), message.get_srcComponent())
+                self._encoder.home_position_send(
+                    round(home.latitude_deg * 1e7), round(home.longitude_deg * 1e7),
+                    round(home.altitude_amsl_m * 1000), 0.0, 0.0, 0.0, [1.0, 0.0, 0.0, 0.0],
+                    0.0, 0.0, 0.0)
             return True
         if kind == "COMMAND_LONG" and message.command == MAV_CMD_MISSION_START:
             started = self.start_mission()
@@ -274,35 +305,77 @@ class SimulatedVehicle:
             return True
         return False
 
+    def _answer_parameter(self, message) -> None:
+        """PARAM_VALUE for a navigation parameter an ArduPilot vehicle has (by name or index);
+        like a real vehicle it stays silent for a name it does not know."""
+        if self.settings.autopilot != Autopilot.ARDUPILOTMEGA:
+            return
+        name = message.param_id.rstrip("\0") if isinstance(message.param_id, str) \
+            else message.param_id.decode().rstrip("\0")
+        if message.param_index >= 0 and not name:
+            name = NAMES[message.param_index] if message.param_index < len(NAMES) else ""
+        if name not in NAMES:
+            return
+        with self._link_lock:
+            self._encoder.srcSystem, self._encoder.srcComponent = 1, 1
+            self._encoder.param_value_send(name.encode(), float(getattr(self.settings.parameters, name)),
+                                           MAV_PARAM_TYPE_REAL32, len(NAMES), NAMES.index(name))
+
     # -- the mission ---------------------------------------------------------------------------
+
+    def _serve_download(self, message) -> None:
+        """Answer a ground station's download from what the vehicle stored: the count for
+        MISSION_REQUEST_LIST, the item for either request form (any seq, any order, as often
+        as asked); its final MISSION_ACK needs no answer."""
+        kind = message.get_type()
+        if kind == "MISSION_ACK":
+            return
+        if kind == "MISSION_REQUEST_LIST":
+            # MAVSDK hands over an accepted upload after its final ACK: wait for it briefly.
+            self._stored.wait(1.0)
+        system, component = message.get_srcSystem(), message.get_srcComponent()
+        mission = list(self.mission)
+        with self._link_lock:
+            self._encoder.srcSystem, self._encoder.srcComponent = 1, 1
+            if kind == "MISSION_REQUEST_LIST":
+                self._encoder.mission_count_send(system, component, len(mission), 0)
+            elif 0 <= message.seq < len(mission):
+                i = mission[message.seq]
+                self._encoder.mission_item_int_send(
+                    system, component, i.seq, i.frame, i.command, 0, i.autocontinue, i.param1,
+                    i.param2, i.param3, i.param4, i.x, i.y, i.z, 0)
+            else:
+                self._encoder.mission_ack_send(system, component, MAV_MISSION_INVALID_SEQUENCE, 0)
+
+    def _with_own_home(self, items: list[WireItem]) -> list[WireItem]:
+        """ArduPilot keeps its own home at seq 0, whatever was sent there."""
+        if not items or first_mission_seq(self.settings.autopilot) == 0:
+            return items
+        home = self.settings.home
+        own = WireItem.normalised(0, Frame.GLOBAL, 16, 0, 1, 0, 0, 0, 0,
+                                  round(home.latitude_deg * 1e7), round(home.longitude_deg * 1e7),
+                                  home.altitude_amsl_m)
+        return [own] + items[1:]
 
     def _set_mission(self, items: list[WireItem]) -> None:
         self.mission = items
+        self._stored.set()
 
     def _on_mission(self, result, plan, _user_data=None) -> None:
         if getattr(result, "name", "") != "SUCCESS" or plan is None:
             return
         self.uploads += 1
-        self._set_mission([WireItem.normalised(i.seq, i.frame, i.command, i.current,
-                                               i.autocontinue, i.param1, i.param2, i.param3,
-                                               i.param4, i.x, i.y, i.z, i.mission_type)
-                           for i in plan.mission_items])
+        # Kept as the autopilot stores it: what it flies is what a download would return.
+        self._set_mission(self._with_own_home([stored_item(WireItem.normalised(
+            i.seq, i.frame, i.command, 0, i.autocontinue, i.param1, i.param2, i.param3,
+            i.param4, i.x, i.y, i.z, i.mission_type), self.settings.autopilot)
+            for i in plan.mission_items]))
         if self.settings.autostart:
             self._start_requested = True     # the flight loop starts it, off MAVSDK's thread
 
     def local_items(self) -> list[LocalItem]:
         """The mission in the local frame (altitudes above home)."""
-        items = []
-        home_amsl = self.settings.home.altitude_amsl_m
-        for item in self.mission:
-            if item.frame == Frame.MISSION:
-                x = y = math.nan
-            else:
-                x, y = self.frame.to_local(np.array([item.x / 1e7]), np.array([item.y / 1e7]))[0]
-            altitude = item.z - home_amsl if item.frame == Frame.GLOBAL else item.z
-            items.append(LocalItem(item.seq, item.command, float(x), float(y), altitude,
-                                   (item.param1, item.param2, item.param3, item.param4)))
-        return items
+        return local_items(self.mission, self.frame, self.settings.home.altitude_amsl_m)
 
     def start_mission(self) -> bool:
         """Take off and fly the mission from its first item; False without a mission or

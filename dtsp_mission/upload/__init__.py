@@ -12,10 +12,12 @@ from __future__ import annotations
 import time
 from dataclasses import dataclass
 
+from ..autopilot import Autopilot
+from ..autopilot.parameters import ARDUPLANE_DEFAULTS, NAMES, VehicleParameters, parameters_from
 from ..errors import InputError, LinkError
 from ..mission import VehicleMission
 from ..plugins import load_group, working
-from .base import Progress, Uploader
+from .base import Progress, Uploader, VehicleInfo
 from .wire import WireItem, describe_vehicle, differences, to_wire
 
 UPLOADER_GROUP = "dtsp_mission.uploaders"
@@ -45,15 +47,60 @@ class UploadReport:
     resent: int
     verified: bool
     note: str = ""
+    warnings: tuple[str, ...] = ()    # what the vehicle differs in from what the plan expects
+
+
+#: A plan whose home is farther than this from the vehicle's is warned about.
+HOME_WARNING_M = 1000.0
+_AUTOPILOT_NAMES = {Autopilot.ARDUPILOTMEGA: "ArduPilot", Autopilot.PX4: "PX4"}
+
+
+def _autopilot_name(value: int) -> str:
+    return _AUTOPILOT_NAMES.get(value, f"MAV_AUTOPILOT {value}")
+
+
+def vehicle_warnings(mission: VehicleMission, info: VehicleInfo,
+                     designed_for: VehicleParameters | None = None) -> list[str]:
+    """What to tell before an upload: raises :class:`LinkError` if the vehicle runs another
+    autopilot than the plan was made for; warns for each navigation parameter that differs
+    from ``designed_for`` (ArduPilot's stock values by default) and for a home far away."""
+    if info.autopilot is not None and info.autopilot != int(mission.autopilot) and \
+            info.autopilot in _AUTOPILOT_NAMES:
+        raise LinkError(f"the plan was made for {_autopilot_name(mission.autopilot)}, but the "
+                        f"vehicle runs {_autopilot_name(info.autopilot)}: plan again with "
+                        f"--autopilot {'px4' if info.autopilot == Autopilot.PX4 else 'ardupilot'}",
+                        "nothing was sent; the vehicle keeps its mission")
+    warnings = []
+    if not info.checked:
+        return ["the vehicle's parameters and home were not checked (this uploader cannot ask)"]
+    if mission.autopilot == Autopilot.ARDUPILOTMEGA and info.parameters:
+        expected = designed_for or ARDUPLANE_DEFAULTS
+        on_vehicle = parameters_from(info.parameters, expected)
+        for name, ours, theirs in expected.differing(on_vehicle):
+            warnings.append(f"the vehicle's {name} is {theirs:g}, the mission was designed for "
+                            f"{ours:g}: it will fly differently than predicted")
+    if info.home_deg is not None:
+        from pyproj import Geod
+        _, _, distance = Geod(ellps="WGS84").inv(mission.home.longitude_deg, mission.home.latitude_deg,
+                                                 info.home_deg[1], info.home_deg[0])
+        if distance > HOME_WARNING_M:
+            warnings.append(f"the plan's home is {distance / 1000:.1f} km from the vehicle's home "
+                            f"({info.home_deg[0]:.6f}, {info.home_deg[1]:.6f}): is this the right "
+                            "vehicle and the right plan?")
+    return warnings
 
 
 def upload_mission(mission: VehicleMission, connection: str, via: str = "pymavlink",
                    verify: bool = True, signing_key: bytes | None = None,
                    progress: Progress | None = None,
-                   heartbeat_timeout_s: float | None = None) -> UploadReport:
+                   heartbeat_timeout_s: float | None = None,
+                   designed_for: VehicleParameters | None = None) -> UploadReport:
     """Upload ``mission`` and, with ``verify``, download it back and compare item by item.
 
-    Returns only when the vehicle accepted the mission (and, with ``verify``, holds exactly
+    Before anything is sent, the vehicle's autopilot is checked against the plan's (a
+    mismatch is a :class:`LinkError`) and its navigation parameters and home against the
+    plan's (``designed_for``; differences become the report's ``warnings``).  Returns only
+    when the vehicle accepted the mission (and, with ``verify``, holds what it can hold of
     it); otherwise raises :class:`LinkError` whose ``on_vehicle`` says what the vehicle holds.
     """
     uploader_class = get_uploader(via)
@@ -63,6 +110,8 @@ def upload_mission(mission: VehicleMission, connection: str, via: str = "pymavli
     wire = to_wire(mission)
     started = time.perf_counter()
     with uploader_class(connection, signing_key=signing_key, **options) as uploader:
+        names = NAMES if mission.autopilot == Autopilot.ARDUPILOTMEGA else ()
+        warnings = tuple(vehicle_warnings(mission, uploader.vehicle_info(names), designed_for))
         try:
             uploader.upload(wire, progress)
         except LinkError as error:
@@ -74,7 +123,7 @@ def upload_mission(mission: VehicleMission, connection: str, via: str = "pymavli
                                     uploader.resent, True,
                                     f"the transfer ended without an acknowledgement "
                                     f"({error.reason}), but the mission downloaded from the "
-                                    "vehicle is exactly the plan")
+                                    "vehicle is exactly the plan", warnings)
             what = (describe_vehicle(on_vehicle, wire, mission.autopilot) if verify else
                     "the vehicle may hold part of this mission (not checked: --no-verify)")
             raise LinkError(f"upload failed: {error.reason}", what) from None
@@ -91,7 +140,7 @@ def upload_mission(mission: VehicleMission, connection: str, via: str = "pymavli
                                 "from it differs from the plan: " + "; ".join(problems),
                                 describe_vehicle(on_vehicle, wire, mission.autopilot))
         return UploadReport(via, len(wire), time.perf_counter() - started, uploader.resent,
-                            verify)
+                            verify, warnings=warnings)
 
 
 def _download_or_none(uploader: Uploader) -> list[WireItem] | None:
@@ -108,5 +157,5 @@ def download_mission(connection: str, via: str = "pymavlink",
         return uploader.download()
 
 
-__all__ = ["UPLOADER_GROUP", "UploadReport", "Uploader", "WireItem", "download_mission",
-           "get_uploader", "to_wire", "upload_mission", "uploaders"]
+__all__ = ["UPLOADER_GROUP", "UploadReport", "Uploader", "VehicleInfo", "WireItem", "download_mission",
+           "get_uploader", "to_wire", "upload_mission", "uploaders", "vehicle_warnings"]

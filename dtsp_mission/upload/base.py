@@ -7,6 +7,7 @@ home placeholder, the comparison with the plan, what to say when it fails -- liv
 
 from __future__ import annotations
 
+from dataclasses import dataclass, field
 from typing import Callable
 
 from .wire import WireItem
@@ -19,6 +20,16 @@ TIMEOUT_S = 1.5          # for the first answer (count, list request, final ack)
 ITEM_TIMEOUT_S = 0.25    # between items
 RETRIES = 5
 HEARTBEAT_TIMEOUT_S = 5.0
+
+
+@dataclass(frozen=True)
+class VehicleInfo:
+    """What a vehicle told about itself before an upload; ``None`` / empty when unknown."""
+
+    autopilot: int | None = None                   # MAV_AUTOPILOT of its heartbeat
+    home_deg: tuple[float, float] | None = None    # HOME_POSITION latitude, longitude
+    parameters: dict[str, float] = field(default_factory=dict)
+    checked: bool = False                          # whether the uploader could ask at all
 
 
 class Uploader:
@@ -47,6 +58,11 @@ class Uploader:
 
     def close(self) -> None:
         raise NotImplementedError
+
+    def vehicle_info(self, parameter_names: tuple[str, ...] = ()) -> VehicleInfo:
+        """The vehicle's autopilot, home and the named parameters, as far as this uploader
+        can ask (the default: nothing is known)."""
+        return VehicleInfo()
 
     def upload(self, items: list[WireItem], progress: Progress | None = None) -> None:
         """Send ``items`` (seq 0 first); returns when the vehicle accepted them."""

@@ -17,7 +17,7 @@ from pymavlink import mavutil
 from ..errors import LinkError
 from ..mission import Command
 from .connection import check_host
-from .base import ITEM_TIMEOUT_S, RETRIES, TIMEOUT_S, Progress, Uploader
+from .base import ITEM_TIMEOUT_S, RETRIES, TIMEOUT_S, Progress, Uploader, VehicleInfo
 from .results import ITEM_RESULTS, NO_SPACE, result_text
 from .wire import MISSION_TYPE_MISSION, WireItem
 
@@ -26,6 +26,8 @@ GCS_COMPONENT_ID = 190          # MAV_COMP_ID_MISSIONPLANNER
 MAV_TYPE_GCS = 6
 MAV_AUTOPILOT_INVALID = 8
 HEARTBEAT_PERIOD_S = 1.0
+MAV_CMD_REQUEST_MESSAGE = 512
+MAVLINK_MSG_ID_HOME_POSITION = 242
 
 
 def use_mavlink2() -> None:
@@ -111,6 +113,7 @@ class PymavlinkUploader(Uploader):
             if message is not None and message.type != MAV_TYPE_GCS \
                     and message.autopilot != MAV_AUTOPILOT_INVALID:
                 self._target = (message.get_srcSystem(), message.get_srcComponent())
+                self._autopilot = int(message.autopilot)
                 raw = bytes(message.get_msgbuf())
                 self._vehicle_signs = raw[:1] == b"\xfd" and bool(raw[2] & 0x01)   # signed flag
                 return
@@ -132,6 +135,35 @@ class PymavlinkUploader(Uploader):
             hint = ": the vehicle signs its messages and may ignore unsigned ones; give --signing-key"
         return LinkError(f"the vehicle stopped answering ({what}; {RETRIES} retries, "
                          f"timeouts {TIMEOUT_S:g} s / {ITEM_TIMEOUT_S:g} s){hint}")
+
+    # -- what the vehicle is ---------------------------------------------------------------------
+
+    def vehicle_info(self, parameter_names: tuple[str, ...] = ()) -> VehicleInfo:
+        """Its autopilot (heartbeat), home (HOME_POSITION, asked with MAV_CMD_REQUEST_MESSAGE)
+        and the named parameters (PARAM_REQUEST_READ, asked twice at most)."""
+        system, component = self._target
+        values: dict[str, float] = {}
+        for _ in range(2):
+            missing = [n for n in parameter_names if n not in values]
+            if not missing:
+                break
+            for name in missing:
+                self._link.mav.param_request_read_send(system, component, name.encode(), -1)
+            deadline = time.monotonic() + TIMEOUT_S
+            while (remaining := deadline - time.monotonic()) > 0 and len(values) < len(parameter_names):
+                message = self._receive({"PARAM_VALUE"}, remaining)
+                if message is not None:
+                    name = message.param_id.rstrip("\0") if isinstance(message.param_id, str) \
+                        else message.param_id.decode().rstrip("\0")
+                    if name in parameter_names:
+                        values[name] = float(message.param_value)
+        home = None
+        self._link.mav.command_long_send(system, component, MAV_CMD_REQUEST_MESSAGE, 0,
+                                         MAVLINK_MSG_ID_HOME_POSITION, 0, 0, 0, 0, 0, 0)
+        message = self._receive({"HOME_POSITION"}, TIMEOUT_S)
+        if message is not None:
+            home = (message.latitude / 1e7, message.longitude / 1e7)
+        return VehicleInfo(self._autopilot, home, values, True)
 
     # -- the mission protocol ------------------------------------------------------------------
 

@@ -2,52 +2,19 @@
 
 This is the one place where a :class:`~dtsp_mission.mission.VehicleMission` becomes
 sequence-numbered wire items (ArduPilot's home placeholder at seq 0 included) and where a
-downloaded mission is compared with the plan.  Values are normalised to what the wire can
-carry (params and altitude as float32, latitude and longitude as int32 1e-7 degrees), so two
-lists compare equal exactly when the vehicle holds the planned mission.
+downloaded mission is compared with the plan.  Each planned item is compared in the form the
+autopilot stores it (:func:`~dtsp_mission.autopilot.storage.comparable`: ArduPilot's packed
+radii, 1/256 turns and centimetres, frame 0 for items without a position), so two lists compare
+equal exactly when the vehicle holds what it can hold of the planned mission.
 """
 
 from __future__ import annotations
 
-from dataclasses import dataclass, fields
+from dataclasses import fields
 
-import numpy as np
-
+from ..autopilot.storage import MISSION_TYPE_MISSION, WireItem, comparable
 from ..mission import Autopilot, Command, Frame, VehicleMission, degrees_to_e7
 from ..mission.model import Home, MissionItem
-
-MISSION_TYPE_MISSION = 0
-
-
-def _f32(value: float) -> float:
-    return float(np.float32(value))
-
-
-@dataclass(frozen=True)
-class WireItem:
-    """One MISSION_ITEM_INT, field for field (``x``/``y`` are int32 1e-7 degrees)."""
-
-    seq: int
-    frame: int
-    command: int
-    current: int
-    autocontinue: int
-    param1: float
-    param2: float
-    param3: float
-    param4: float
-    x: int
-    y: int
-    z: float
-    mission_type: int = MISSION_TYPE_MISSION
-
-    @classmethod
-    def normalised(cls, seq, frame, command, current, autocontinue, param1, param2, param3,
-                   param4, x, y, z, mission_type=MISSION_TYPE_MISSION) -> "WireItem":
-        """The item with every value as the wire carries it."""
-        return cls(int(seq), int(frame), int(command), int(current), int(bool(autocontinue)),
-                   _f32(param1), _f32(param2), _f32(param3), _f32(param4), int(x), int(y),
-                   _f32(z), int(mission_type))
 
 
 #: Fields compared between plan and vehicle (``current`` is state, not content).
@@ -90,22 +57,32 @@ def from_wire(wire: list[WireItem], autopilot: Autopilot) -> list[MissionItem]:
     return items
 
 
+def holds(planned_item: WireItem, vehicle_item: WireItem, autopilot: Autopilot) -> bool:
+    """Whether the vehicle's item is the planned one: in the form the autopilot stores it, or
+    exactly as sent (a vehicle that keeps items verbatim)."""
+    got = comparable(vehicle_item, autopilot, sent=False)
+    return got == comparable(planned_item, autopilot) or \
+        got == comparable(planned_item, autopilot, sent=False)
+
+
 def differences(planned: list[WireItem], on_vehicle: list[WireItem],
                 autopilot: Autopilot, limit: int = 5) -> list[str]:
     """How the vehicle's mission differs from the plan, at most ``limit`` lines (empty if it
     holds exactly the plan)."""
     problems = []
+    first = first_mission_seq(autopilot)
     if len(planned) != len(on_vehicle):
         problems.append(f"the vehicle holds {len(on_vehicle)} items, the plan has {len(planned)}")
     for planned_item, vehicle_item in zip(planned, on_vehicle):
-        if planned_item.seq < first_mission_seq(autopilot):
+        if planned_item.seq < first or holds(planned_item, vehicle_item, autopilot):
             continue
-        changed = [name for name in COMPARED
-                   if getattr(planned_item, name) != getattr(vehicle_item, name)]
+        expected = comparable(planned_item, autopilot)
+        got = comparable(vehicle_item, autopilot, sent=False)
+        changed = [name for name in COMPARED if getattr(expected, name) != getattr(got, name)]
         if changed:
             problems.append(f"item {planned_item.seq} differs in " + ", ".join(
                 f"{name} ({getattr(vehicle_item, name)!r} instead of "
-                f"{getattr(planned_item, name)!r})" for name in changed))
+                f"{getattr(expected, name)!r})" for name in changed))
     if len(problems) > limit:
         problems = problems[:limit] + [f"... and {len(problems) - limit} more differences"]
     return problems
@@ -123,8 +100,8 @@ def describe_vehicle(on_vehicle: list[WireItem] | None, planned: list[WireItem],
         return "the vehicle holds exactly the planned mission"
     same = 0
     for planned_item, vehicle_item in zip(planned, on_vehicle):
-        if planned_item.seq >= first_mission_seq(autopilot) and any(
-                getattr(planned_item, n) != getattr(vehicle_item, n) for n in COMPARED):
+        if planned_item.seq >= first_mission_seq(autopilot) and \
+                not holds(planned_item, vehicle_item, autopilot):
             break
         same += 1
     matching = max(0, same - first_mission_seq(autopilot))
@@ -132,5 +109,6 @@ def describe_vehicle(on_vehicle: list[WireItem] | None, planned: list[WireItem],
             f"items match the plan): do not fly it")
 
 
-__all__ = ["COMPARED", "WireItem", "describe_vehicle", "differences", "first_mission_seq",
+__all__ = ["COMPARED", "MISSION_TYPE_MISSION", "WireItem", "describe_vehicle", "differences",
+           "first_mission_seq", "holds",
            "from_wire", "home_placeholder", "to_wire"]

@@ -9,7 +9,7 @@ import numpy as np
 import pytest
 
 from conftest import make_mission
-from dtsp_mission.sim.flight import G, Airframe, MissionFlight, closest_approach_m
+from dtsp_mission.autopilot.navigation import G, Airframe, MissionFlight, closest_approach_m
 from dtsp_mission.sim.vehicle import SimulatedVehicle, VehicleSettings
 from dtsp_mission.upload.wire import first_mission_seq, to_wire
 
@@ -51,7 +51,7 @@ def test_with_a_turn_margin_targets_are_passed_within_5_m():
     """An aircraft whose limit is 10 % tighter than the planned rho follows the plan closely;
     the measured miss distances are the figure the docs report."""
     mission = make_mission(30, 11, 80.0, span_m=2500.0, airspeed_m_s=20.0)
-    flight, track, _ = fly_offline(mission, Airframe(20.0, 72.0, 5.0, roll_time_constant_s=0.3))
+    flight, track, _ = fly_offline(mission, Airframe(20.0, 72.0, 5.0, roll_natural_rad_s=6.0, roll_damping=0.8))
     targets = mission.path.chain.pose_at(mission.path.target_s_m)[:, :2]
     miss = closest_approach_m(track[:, :2], targets)
     print(f"miss distances with a 10 % margin: median {np.median(miss):.2f} m, max {miss.max():.2f} m")

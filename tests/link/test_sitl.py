@@ -8,7 +8,7 @@ import pytest
 
 from conftest import make_mission
 from dtsp_mission.sim.fly import fly_mission, targets_in
-from dtsp_mission.sim.flight import Airframe
+from dtsp_mission.autopilot.navigation import Airframe
 
 RHO_M = 80.0
 

@@ -49,7 +49,7 @@ def test_no_space_names_the_limit_and_nothing_is_claimed(via, mission, start_veh
     message = str(caught.value)
     assert "no room" in message and "lower --max-items" in message
     if via == "pymavlink":     # it relays the vehicle's own words, with the limit
-        assert "20 items fit" in message
+        assert "Only 20 items are supported" in message
     assert "holds no mission" in caught.value.on_vehicle
     assert vehicle.mission == []
 

@@ -1,0 +1,82 @@
+"""A vehicle's navigation parameters, from the parameter file ArduPilot and MAVProxy write.
+
+A ``.parm`` file is one ``NAME VALUE`` per line (``#`` comments, commas accepted as the
+separator, as Mission Planner writes them).  :class:`VehicleParameters` keeps the values the
+flight model uses, under ArduPlane's names; :data:`ARDUPLANE_DEFAULTS` are those of a stock
+ArduPlane SITL (firmware defaults with ArduPilot's standard ``plane.parm``), the vehicle every
+flight in ``tests/data/arduplane-sitl`` was recorded with.
+"""
+
+from __future__ import annotations
+
+import math
+import os
+from dataclasses import dataclass, fields, replace
+from pathlib import Path
+
+from ..errors import FileAccessError, FileFormatError
+
+
+@dataclass(frozen=True)
+class VehicleParameters:
+    """The navigation parameters of an ArduPlane, by their ArduPilot names (units as there)."""
+
+    NAVL1_PERIOD: float = 15.0        # s
+    NAVL1_DAMPING: float = 0.75
+    NAVL1_XTRACK_I: float = 0.02
+    WP_RADIUS: float = 50.0           # m
+    WP_MAX_RADIUS: float = 0.0        # m, 0: no limit
+    WP_LOITER_RAD: float = 80.0       # m
+    AIRSPEED_CRUISE: float = 22.0     # m/s
+    ROLL_LIMIT_DEG: float = 65.0
+    TECS_CLMB_MAX: float = 5.0        # m/s
+    TECS_SINK_MAX: float = 5.0        # m/s
+    TECS_TIME_CONST: float = 5.0      # s
+    TKOFF_LVL_PITCH: float = 15.0     # deg
+    RTL_ALTITUDE: float = 100.0       # m
+    RTL_RADIUS: float = 0.0           # m, 0: WP_LOITER_RAD
+
+    def l1_distance_m(self, speed_m_s: float) -> float:
+        """ArduPlane's L1 distance at this ground speed."""
+        return self.NAVL1_DAMPING * self.NAVL1_PERIOD * speed_m_s / math.pi
+
+    def differing(self, other: "VehicleParameters") -> list[tuple[str, float, float]]:
+        """(name, ours, theirs) of every parameter whose values differ."""
+        return [(f.name, getattr(self, f.name), getattr(other, f.name)) for f in fields(self)
+                if not math.isclose(getattr(self, f.name), getattr(other, f.name),
+                                    rel_tol=1e-6, abs_tol=1e-9)]
+
+
+ARDUPLANE_DEFAULTS = VehicleParameters()
+NAMES = tuple(f.name for f in fields(VehicleParameters))
+
+
+def parse_parameters(text: str, where: str = "parameters") -> dict[str, float]:
+    """Every ``NAME VALUE`` of a parameter file's text, by name."""
+    values: dict[str, float] = {}
+    for number, line in enumerate(text.splitlines(), 1):
+        line = line.split("#", 1)[0].strip()
+        if not line:
+            continue
+        parts = line.replace(",", " ").split()
+        if len(parts) < 2:
+            raise FileFormatError(f"{where}, line {number}: expected NAME VALUE, got {line!r}")
+        try:
+            values[parts[0].upper()] = float(parts[1])
+        except ValueError:
+            raise FileFormatError(f"{where}, line {number}: {parts[1]!r} is not a number") from None
+    return values
+
+
+def parameters_from(values: dict[str, float], base: VehicleParameters = ARDUPLANE_DEFAULTS) -> VehicleParameters:
+    """``base`` with every navigation parameter found in ``values`` (others are ignored)."""
+    return replace(base, **{name: values[name] for name in NAMES if name in values})
+
+
+def read_parameters(path: str | os.PathLike) -> VehicleParameters:
+    """The navigation parameters in a ``.parm`` file; the stock defaults for any it lacks."""
+    try:
+        text = Path(path).read_text(encoding="utf-8", errors="replace")
+    except OSError as error:
+        raise FileAccessError(f"cannot read the vehicle parameters {path}: {error.strerror}") from None
+    return parameters_from(parse_parameters(text, str(path)))

@@ -1,0 +1,170 @@
+"""What an autopilot keeps of a mission item, and how many it keeps.
+
+A vehicle does not store the MISSION_ITEM_INT it was sent: ArduPilot packs every item into
+15 bytes (``AP_Mission``) and hands back what it stored, PX4 keeps its own ``mission_item``
+struct.  :func:`stored_item` gives, for an item sent to an autopilot, the item that autopilot
+returns on download; the simulated vehicle stores that, and the uploader compares a download
+with it, so a storage normalisation never looks like a corrupted upload while any real change
+(a position, a command, a parameter beyond the storage resolution, an item missing) still
+does.
+
+ArduPilot's rules are the ones measured on ArduPlane 4.7 (``tests/data/arduplane-sitl/facts.md``
+and every ``readback.json`` there are golden tests).  PX4's are taken from its mission manager
+as documented (parameters as float32, positions exact to 1e-7 degree); no PX4 flight is in
+the data set, so for PX4 the comparison also treats the plain and ``_INT`` forms of a frame as
+one.
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass, replace
+
+import numpy as np
+
+from .commands import Autopilot, Command, Frame
+
+MISSION_TYPE_MISSION = 0
+#: Mission slots of a stock vehicle: ArduPlane SITL answers MISSION_COUNT 656 with NO_SPACE
+#: ("Only 655 items are supported", home at seq 0 included); PX4's default dataman holds 500.
+CAPACITY = {Autopilot.ARDUPILOTMEGA: 655, Autopilot.PX4: 500}
+#: MAVLink's sequence numbers are 16 bits: no vehicle can take more items than this.
+MAVLINK_MAX_ITEMS = 65535
+
+
+def _f32(value: float) -> float:
+    return float(np.float32(value))
+
+
+@dataclass(frozen=True)
+class WireItem:
+    """One MISSION_ITEM_INT, field for field (``x``/``y`` are int32 1e-7 degrees)."""
+
+    seq: int
+    frame: int
+    command: int
+    current: int
+    autocontinue: int
+    param1: float
+    param2: float
+    param3: float
+    param4: float
+    x: int
+    y: int
+    z: float
+    mission_type: int = MISSION_TYPE_MISSION
+
+    @classmethod
+    def normalised(cls, seq, frame, command, current, autocontinue, param1, param2, param3,
+                   param4, x, y, z, mission_type=MISSION_TYPE_MISSION) -> "WireItem":
+        """The item with every value as the wire carries it."""
+        return cls(int(seq), int(frame), int(command), int(current), int(bool(autocontinue)),
+                   _f32(param1), _f32(param2), _f32(param3), _f32(param4), int(x), int(y),
+                   _f32(z), int(mission_type))
+
+
+# -- ArduPilot ---------------------------------------------------------------------------------
+
+#: Commands ArduPilot stores with a location, and commands it stores without one (these come
+#: back in frame 0 with no position); any other command is compared as the wire carries it.
+_AP_LOCATION_COMMANDS = {Command.NAV_WAYPOINT, Command.NAV_LOITER_UNLIM, Command.NAV_LOITER_TURNS,
+                         Command.NAV_LOITER_TIME, Command.NAV_LAND, Command.NAV_TAKEOFF,
+                         Command.DO_LAND_START}
+_AP_NO_LOCATION_COMMANDS = {Command.NAV_RETURN_TO_LAUNCH, Command.DO_CHANGE_SPEED}
+#: The frames ArduPilot keeps as a flag: the ``_INT`` forms come back in their plain form.
+_AP_FRAMES = {Frame.GLOBAL_INT: Frame.GLOBAL, Frame.GLOBAL_RELATIVE_ALT_INT: Frame.GLOBAL_RELATIVE_ALT,
+              Frame.GLOBAL_TERRAIN_ALT_INT: Frame.GLOBAL_TERRAIN_ALT}
+
+
+def _byte(value: float) -> int:
+    """A parameter stored in one unsigned byte (truncated, clamped to 0..255)."""
+    return int(min(max(math.trunc(value), 0), 255)) if math.isfinite(value) else 0
+
+
+def _ap_loiter_radius(radius_m: float) -> float:
+    """A loiter radius in ArduPilot's byte: whole metres to 255 m, 10 m steps to 2550 m; the
+    sign (direction) kept."""
+    size = abs(radius_m)
+    kept = _byte(size) if size <= 255 else min(math.trunc(size / 10.0), 255) * 10
+    return float(-kept if radius_m < 0 else kept)
+
+
+def _ap_turns(turns: float) -> float:
+    """LOITER_TURNS' count: below one turn in 1/256 turn, else whole turns up to 255."""
+    if 0 < turns < 1:
+        return math.trunc(turns * 256) / 256.0
+    return float(_byte(turns))
+
+
+def _ap_altitude(z_m: float) -> float:
+    """Altitude kept as int32 centimetres (float32 arithmetic, truncated), returned in metres."""
+    centimetres = math.trunc(float(np.float32(z_m) * np.float32(100.0)))
+    return float(np.float32(centimetres) * np.float32(0.01))
+
+
+def _ardupilot(item: WireItem) -> WireItem:
+    command = item.command
+    if command in _AP_NO_LOCATION_COMMANDS:
+        return replace(item, frame=int(Frame.GLOBAL), **_ap_params(item), x=0, y=0, z=0.0)
+    if command not in _AP_LOCATION_COMMANDS:
+        return item
+    frame = int(_AP_FRAMES.get(item.frame, item.frame))
+    return replace(item, frame=frame, **_ap_params(item), z=_ap_altitude(item.z))
+
+
+def _ap_params(item: WireItem) -> dict[str, float]:
+    p1, p2, p3, p4 = item.param1, item.param2, item.param3, item.param4
+    command = item.command
+    if command == Command.NAV_WAYPOINT:      # acceptance and pass radius in a byte each
+        return dict(param1=0.0, param2=float(_byte(p2)), param3=float(_byte(p3)), param4=0.0)
+    if command == Command.NAV_LOITER_TURNS:
+        return dict(param1=_ap_turns(p1), param2=0.0, param3=_ap_loiter_radius(p3),
+                    param4=1.0 if p4 > 0 else 0.0)
+    if command == Command.NAV_LOITER_UNLIM:
+        return dict(param1=0.0, param2=0.0, param3=_ap_loiter_radius(p3), param4=0.0)
+    if command == Command.NAV_LOITER_TIME:   # the time in seconds; of the radius only its sign
+        return dict(param1=float(min(max(math.trunc(p1), 0), 65535)), param2=0.0,
+                    param3=-1.0 if p3 < 0 else 1.0, param4=1.0 if p4 > 0 else 0.0)
+    if command == Command.NAV_TAKEOFF:       # the pitch in whole degrees
+        return dict(param1=float(_byte(p1)), param2=0.0, param3=0.0, param4=0.0)
+    if command == Command.NAV_RETURN_TO_LAUNCH:
+        return dict(param1=0.0, param2=0.0, param3=0.0, param4=0.0)
+    if command == Command.DO_CHANGE_SPEED:   # speed type in a byte, speed and throttle as floats
+        return dict(param1=float(_byte(p1)), param2=_f32(p2), param3=_f32(p3), param4=0.0)
+    return dict(param1=_f32(p1), param2=_f32(p2), param3=_f32(p3), param4=_f32(p4))
+
+
+# -- PX4 ---------------------------------------------------------------------------------------
+
+_PX4_FRAMES = {Frame.GLOBAL_INT: Frame.GLOBAL, Frame.GLOBAL_RELATIVE_ALT_INT: Frame.GLOBAL_RELATIVE_ALT,
+               Frame.GLOBAL_TERRAIN_ALT_INT: Frame.GLOBAL_TERRAIN_ALT}
+
+
+def _px4(item: WireItem) -> WireItem:
+    return WireItem.normalised(item.seq, item.frame, item.command, item.current, item.autocontinue,
+                               item.param1, item.param2, item.param3, item.param4, item.x,
+                               item.y, item.z, item.mission_type)
+
+
+def stored_item(item: WireItem, autopilot: Autopilot) -> WireItem:
+    """What ``autopilot`` returns on download for ``item`` sent to it (``seq`` and
+    ``current`` unchanged)."""
+    if autopilot == Autopilot.ARDUPILOTMEGA:
+        return _ardupilot(WireItem.normalised(**item.__dict__))
+    return _px4(item)
+
+
+def comparable(item: WireItem, autopilot: Autopilot, sent: bool = True) -> WireItem:
+    """The item as it must come back from ``autopilot``: a ``sent`` item in its stored form,
+    a downloaded one as it is; on PX4, whose downloads may give a frame in its plain or
+    ``_INT`` form, both with the plain form.  (The stored form is not applied twice: storing
+    truncates, so a download stored again would lose another centimetre.)"""
+    kept = stored_item(item, autopilot) if sent else WireItem.normalised(**item.__dict__)
+    if autopilot == Autopilot.PX4:
+        kept = replace(kept, frame=int(_PX4_FRAMES.get(kept.frame, kept.frame)))
+    return kept
+
+
+def capacity(autopilot: Autopilot) -> int:
+    """Mission slots of a stock vehicle of this autopilot (ArduPilot's home slot included)."""
+    return CAPACITY[autopilot]

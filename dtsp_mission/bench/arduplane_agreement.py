@@ -1,0 +1,160 @@
+"""How closely the flight model reproduces a recorded ArduPlane flight.
+
+A case folder holds what a real ArduPlane SITL was given and what it did (the format of
+``tests/data/arduplane-sitl``: ``mission.plan``, ``params.parm``, ``track.csv``, ``reached.csv``,
+``items.csv`` and, for planned missions, ``misses.csv``).  :func:`compare_case` flies the same
+mission, as the vehicle stored it, with the recorded parameters, and measures:
+
+* item timing: each item's MISSION_ITEM_REACHED time after the take-off completed, the model's
+  scaled to the real flight's duration, the difference per item;
+* the track: the distance of every real 10 Hz position (take-off end to last item) from the
+  model's track;
+* closest approach: per waypoint (or, for planned missions, per target), the model's least
+  distance minus the real one.
+"""
+
+from __future__ import annotations
+
+import csv
+import json
+import math
+from dataclasses import dataclass
+from pathlib import Path
+
+import numpy as np
+
+from ..autopilot import Autopilot, Command, stored_item
+from ..autopilot.navigation import Airframe, MissionFlight, closest_approach_m, local_items
+from ..autopilot.parameters import read_parameters
+from ..export import read_mission
+from ..frame import LocalFrame
+from ..upload.wire import first_mission_seq, to_wire
+
+
+@dataclass(frozen=True)
+class Agreement:
+    """The figures of one case (metres and seconds)."""
+
+    case: str
+    items_timed: int
+    timing_median_s: float
+    timing_max_s: float
+    track_median_m: float
+    track_p95_m: float
+    track_max_m: float
+    points: int
+    approach_median_m: float      # |model - real| closest approach
+    approach_max_m: float
+    real_approach_median_m: float
+    model_approach_median_m: float
+    real_length_m: float
+    model_length_m: float
+
+    def row(self) -> list[str]:
+        return [self.case, f"{self.items_timed}", f"{self.timing_median_s:.1f}",
+                f"{self.timing_max_s:.1f}", f"{self.track_median_m:.1f}",
+                f"{self.track_p95_m:.1f}", f"{self.track_max_m:.1f}", f"{self.points}",
+                f"{self.real_approach_median_m:.1f}", f"{self.model_approach_median_m:.1f}",
+                f"{self.approach_median_m:.1f}", f"{self.approach_max_m:.1f}",
+                f"{self.real_length_m:,.0f}", f"{self.model_length_m:,.0f}"]
+
+
+HEADER = ["case", "items timed", "timing median s", "timing max s", "track median m",
+          "track p95 m", "track max m", "points", "real closest median m",
+          "model closest median m", "closest |diff| median m", "closest |diff| max m",
+          "real flown m", "model flown m"]
+
+
+def _rows(path: Path) -> list[dict[str, str]]:
+    with path.open(newline="") as handle:
+        return list(csv.DictReader(handle))
+
+
+def _length(xy: np.ndarray) -> float:
+    return float(np.hypot(*np.diff(xy, axis=0).T).sum()) if len(xy) > 1 else 0.0
+
+
+def fly_recorded_mission(folder: Path, airframe: Airframe | None = None, dt_s: float = 0.02,
+                         ) -> tuple[MissionFlight, np.ndarray, LocalFrame]:
+    """The model's flight of the case's mission (as ArduPilot stored it) with the case's
+    parameters: the flight and its track rows (time, x, y, altitude)."""
+    mission = read_mission(folder / "mission.plan")
+    home = mission.home
+    frame = LocalFrame(home.latitude_deg, home.longitude_deg)
+    wire = [stored_item(item, Autopilot.ARDUPILOTMEGA) for item in to_wire(mission)]
+    items = local_items(wire, frame, home.altitude_amsl_m)
+    first = first_mission_seq(Autopilot.ARDUPILOTMEGA)
+    takeoff = items[first]
+    heading = math.atan2(takeoff.y_m, takeoff.x_m)
+    airframe = airframe or Airframe.from_parameters(read_parameters(folder / "params.parm"))
+    flight = MissionFlight(items, airframe, heading, first)
+    last_nav = max(i.seq for i in items if i.command != Command.NAV_RETURN_TO_LAUNCH
+                   and i.command in (Command.NAV_WAYPOINT, Command.NAV_LOITER_TURNS))
+    track = [(0.0, 0.0, 0.0, 0.0)]
+    while not flight.finished and flight.state.time_s < 7200:
+        flight.step(dt_s)
+        s = flight.state
+        track.append((s.time_s, s.x_m, s.y_m, s.alt_m))
+        if any(seq == last_nav for seq, _ in flight.reached[-3:]):
+            break
+    return flight, np.array(track), frame
+
+
+def compare_case(folder: str | Path, airframe: Airframe | None = None) -> Agreement:
+    """The model against the recorded flight in ``folder``."""
+    folder = Path(folder)
+    flight, model, frame = fly_recorded_mission(folder, airframe)
+    model_reached = dict(flight.reached)
+
+    real_reached = {int(r["seq"]): float(r["time_s"]) for r in _rows(folder / "reached.csv")
+                    if r["event"] == "reached" and r["time_s"]}
+    start_real, start_model = real_reached[1], model_reached.get(1, 0.0)
+    common = sorted(seq for seq in real_reached if seq in model_reached and seq > 1)
+    end = common[-1]
+    scale = (real_reached[end] - start_real) / max(model_reached[end] - start_model, 1e-9)
+    timing = np.array([abs((model_reached[q] - start_model) * scale - (real_reached[q] - start_real))
+                       for q in common])
+
+    rows = _rows(folder / "track.csv")
+    real_t = np.array([float(r["time_s"]) for r in rows])
+    real_xy = frame.to_local(np.array([float(r["lat"]) for r in rows]),
+                             np.array([float(r["lon"]) for r in rows]))
+    span = (real_t >= start_real) & (real_t <= real_reached[end])
+    real_xy = real_xy[span]
+    model_span = (model[:, 0] >= start_model) & (model[:, 0] <= model_reached[end])
+    model_xy = model[model_span, 1:3]
+    track = closest_approach_m(model_xy, real_xy)
+
+    if (folder / "misses.csv").exists():
+        points = _rows(folder / "misses.csv")
+        real_closest = np.array([float(r["miss_m"]) for r in points])
+    else:
+        points = [r for r in _rows(folder / "items.csv") if int(r["command"]) == Command.NAV_WAYPOINT
+                  and int(r["seq"]) <= end]
+        real_closest = np.array([float(r["closest_whole_track_m"]) for r in points])
+    xy = frame.to_local(np.array([float(r["lat"]) for r in points]),
+                        np.array([float(r["lon"]) for r in points]))
+    after_takeoff = model[:, 0] >= start_model
+    model_closest = closest_approach_m(model[after_takeoff, 1:3], xy)
+    difference = np.abs(model_closest - real_closest)
+
+    return Agreement(folder.name, len(common), float(np.median(timing)), float(timing.max()),
+                     float(np.median(track)), float(np.percentile(track, 95)), float(track.max()),
+                     len(points), float(np.median(difference)), float(difference.max()),
+                     float(np.median(real_closest)), float(np.median(model_closest)),
+                     _length(real_xy), _length(model_xy))
+
+
+def cases(root: str | Path) -> list[Path]:
+    """The case folders under ``root`` (those with a recorded track)."""
+    return sorted(p for p in Path(root).iterdir() if (p / "track.csv").exists())
+
+
+def markdown_table(results: list[Agreement]) -> str:
+    lines = ["| " + " | ".join(HEADER) + " |", "|" + "---|" * len(HEADER)]
+    lines += ["| " + " | ".join(r.row()) + " |" for r in results]
+    return "\n".join(lines) + "\n"
+
+
+def as_json(results: list[Agreement]) -> str:
+    return json.dumps([r.__dict__ for r in results], indent=2)
