@@ -89,3 +89,13 @@ def test_capacity_is_the_stock_vehicles():
     assert probe["656"]["ack_name"] == "MAV_MISSION_NO_SPACE" and probe["655"]["ack_type"] == 0
     assert capacity(ARDUPILOT) == 655
     assert capacity(Autopilot.PX4) == 500
+
+
+@pytest.mark.parametrize("z", [118.9, 113.4, 109.01, 77.19, 123.456])
+def test_a_stored_altitude_is_not_truncated_twice_by_the_check(z):
+    sent = WireItem.normalised(5, 3, 16, 0, 1, 0, 0, 0, 0, 473977000, 85456000, z)
+    kept = stored_item(sent, ARDUPILOT)
+    assert abs(kept.z - z) < 0.01 and kept.z <= z + 1e-6        # centimetres, truncated
+    planned = [sent] * 2
+    assert differences(planned, [kept] * 2, ARDUPILOT) == []
+    assert differences(planned, [replace(kept, z=kept.z - 0.01)] * 2, ARDUPILOT) != []

@@ -119,3 +119,19 @@ def test_bad_connection_string_is_an_input_error(mission):
         upload_mission(mission, "udpout:no-such-host.invalid:14550", heartbeat_timeout_s=1.0)
     with pytest.raises(InputError, match="cannot read the connection"):
         upload_mission(mission, "carrier-pigeon", via="mavsdk")
+
+
+def test_the_simulated_ardupilot_returns_what_ardupilot_stores(start_vehicle):
+    """Downloads come from the vehicle's storage: RTL in frame 0, its own home at seq 0."""
+    from dtsp_mission.autopilot import stored_item
+    ardupilot = make_mission(6, 9, 80.0, span_m=1000.0, airspeed_m_s=20.0).for_vehicle()
+    vehicle = start_vehicle(ardupilot)
+    connection = f"udpout:127.0.0.1:{vehicle.port}"
+    upload_mission(ardupilot, connection)
+    downloaded = download_mission(connection)
+    sent = to_wire(ardupilot)
+    assert downloaded[-1].command == 20 and sent[-1].frame == 2 and downloaded[-1].frame == 0
+    assert downloaded[1:] == [type(s)(**{**stored_item(s, ardupilot.autopilot).__dict__, "current": 0})
+                              for s in sent[1:]]
+    assert (downloaded[0].x, downloaded[0].y) == (round(ardupilot.home.latitude_deg * 1e7),
+                                                  round(ardupilot.home.longitude_deg * 1e7))
