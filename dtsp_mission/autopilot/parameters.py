@@ -35,6 +35,7 @@ class VehicleParameters:
     TKOFF_LVL_PITCH: float = 15.0     # deg
     RTL_ALTITUDE: float = 100.0       # m
     RTL_RADIUS: float = 0.0           # m, 0: WP_LOITER_RAD
+    SCHED_LOOP_RATE: float = 50.0     # Hz, the main loop (navigation runs in it)
 
     def l1_distance_m(self, speed_m_s: float) -> float:
         """ArduPlane's L1 distance at this ground speed."""

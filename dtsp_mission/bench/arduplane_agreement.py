@@ -24,11 +24,21 @@ from pathlib import Path
 import numpy as np
 
 from ..autopilot import Autopilot, Command, stored_item
-from ..autopilot.navigation import Airframe, MissionFlight, closest_approach_m, local_items
+from ..autopilot.navigation import (Airframe, LocalItem, MissionFlight, closest_approach_m,
+                                   local_items)
 from ..autopilot.parameters import read_parameters
 from ..export import read_mission
 from ..frame import LocalFrame
 from ..upload.wire import first_mission_seq, to_wire
+
+
+#: The goals of the simulator issue: name -> (Agreement field, limit).
+GOALS = {"timing 2 s": ("timing_max_s", 2.0), "track median 3 m": ("track_median_m", 3.0),
+         "track max 10 m": ("track_max_m", 10.0), "closest median 1 m": ("approach_median_m", 1.0),
+         "closest max 3 m": ("approach_max_m", 3.0)}
+
+#: The recordings go on this long after the last item was reached.
+RECORDED_AFTER_S = 10.0
 
 
 @dataclass(frozen=True)
@@ -50,19 +60,24 @@ class Agreement:
     real_length_m: float
     model_length_m: float
 
+    def missed_goals(self) -> list[str]:
+        """The simulator issue's goals this case misses (:data:`GOALS`)."""
+        return [name for name, (field, limit) in GOALS.items() if getattr(self, field) > limit]
+
     def row(self) -> list[str]:
         return [self.case, f"{self.items_timed}", f"{self.timing_median_s:.1f}",
                 f"{self.timing_max_s:.1f}", f"{self.track_median_m:.1f}",
                 f"{self.track_p95_m:.1f}", f"{self.track_max_m:.1f}", f"{self.points}",
                 f"{self.real_approach_median_m:.1f}", f"{self.model_approach_median_m:.1f}",
                 f"{self.approach_median_m:.1f}", f"{self.approach_max_m:.1f}",
-                f"{self.real_length_m:,.0f}", f"{self.model_length_m:,.0f}"]
+                f"{self.real_length_m:,.0f}", f"{self.model_length_m:,.0f}",
+                ", ".join(self.missed_goals()) or "all met"]
 
 
 HEADER = ["case", "items timed", "timing median s", "timing max s", "track median m",
           "track p95 m", "track max m", "points", "real closest median m",
           "model closest median m", "closest |diff| median m", "closest |diff| max m",
-          "real flown m", "model flown m"]
+          "real flown m", "model flown m", "goals missed"]
 
 
 def _rows(path: Path) -> list[dict[str, str]]:
@@ -83,6 +98,10 @@ def fly_recorded_mission(folder: Path, airframe: Airframe | None = None, dt_s: f
     frame = LocalFrame(home.latitude_deg, home.longitude_deg)
     wire = [stored_item(item, Autopilot.ARDUPILOTMEGA) for item in to_wire(mission)]
     items = local_items(wire, frame, home.altitude_amsl_m)
+    if items[-1].command != Command.NAV_RETURN_TO_LAUNCH:
+        # ArduPlane: "Mission complete, changing mode to RTL"; the recordings go on 10 s.
+        items.append(LocalItem(len(items), Command.NAV_RETURN_TO_LAUNCH, math.nan, math.nan,
+                               items[-1].alt_m, (0.0, 0.0, 0.0, 0.0)))
     first = first_mission_seq(Autopilot.ARDUPILOTMEGA)
     takeoff = items[first]
     heading = math.atan2(takeoff.y_m, takeoff.x_m)
@@ -91,13 +110,24 @@ def fly_recorded_mission(folder: Path, airframe: Airframe | None = None, dt_s: f
     last_nav = max(i.seq for i in items if i.command != Command.NAV_RETURN_TO_LAUNCH
                    and i.command in (Command.NAV_WAYPOINT, Command.NAV_LOITER_TURNS))
     track = [(0.0, 0.0, 0.0, 0.0)]
-    while not flight.finished and flight.state.time_s < 7200:
+    stop_s = math.inf
+    while not flight.finished and flight.state.time_s < min(stop_s, 7200):
         flight.step(dt_s)
         s = flight.state
         track.append((s.time_s, s.x_m, s.y_m, s.alt_m))
-        if any(seq == last_nav for seq, _ in flight.reached[-3:]):
-            break
+        if stop_s == math.inf and any(seq == last_nav for seq, _ in flight.reached[-3:]):
+            stop_s = s.time_s + RECORDED_AFTER_S
     return flight, np.array(track), frame
+
+
+def _closest_while_current(track: np.ndarray, reached: dict[int, float], seq: int,
+                           point: np.ndarray) -> float:
+    """Least distance of the track to ``point`` while item ``seq`` or the next is current:
+    from the reaching of the item before it to the reaching of the one after (or the end)."""
+    begin = reached.get(seq - 1, 0.0)
+    end = reached.get(seq + 1, np.inf)
+    window = (track[:, 0] >= begin) & (track[:, 0] <= end)
+    return float(closest_approach_m(track[window, 1:3], point[None, :])[0])
 
 
 def compare_case(folder: str | Path, airframe: Airframe | None = None) -> Agreement:
@@ -125,17 +155,21 @@ def compare_case(folder: str | Path, airframe: Airframe | None = None) -> Agreem
     model_xy = model[model_span, 1:3]
     track = closest_approach_m(model_xy, real_xy)
 
-    if (folder / "misses.csv").exists():
+    after_takeoff = model[:, 0] >= start_model
+    if (folder / "misses.csv").exists():       # targets: the whole track after take-off
         points = _rows(folder / "misses.csv")
         real_closest = np.array([float(r["miss_m"]) for r in points])
-    else:
+        xy = frame.to_local(np.array([float(r["lat"]) for r in points]),
+                            np.array([float(r["lon"]) for r in points]))
+        model_closest = closest_approach_m(model[after_takeoff, 1:3], xy)
+    else:                                      # waypoints: while it or the next is current
         points = [r for r in _rows(folder / "items.csv") if int(r["command"]) == Command.NAV_WAYPOINT
                   and int(r["seq"]) <= end]
-        real_closest = np.array([float(r["closest_whole_track_m"]) for r in points])
-    xy = frame.to_local(np.array([float(r["lat"]) for r in points]),
-                        np.array([float(r["lon"]) for r in points]))
-    after_takeoff = model[:, 0] >= start_model
-    model_closest = closest_approach_m(model[after_takeoff, 1:3], xy)
+        real_closest = np.array([float(r["closest_m"]) for r in points])
+        xy = frame.to_local(np.array([float(r["lat"]) for r in points]),
+                            np.array([float(r["lon"]) for r in points]))
+        model_closest = np.array([_closest_while_current(model, model_reached, int(r["seq"]), p)
+                                  for r, p in zip(points, xy)])
     difference = np.abs(model_closest - real_closest)
 
     return Agreement(folder.name, len(common), float(np.median(timing)), float(timing.max()),

@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+import math
 import time
 
 import click
@@ -10,9 +11,8 @@ from ..mission import AUTOPILOTS
 from ..mission.model import Home
 from dataclasses import replace
 
-from ..autopilot.navigation import Airframe
+from ..autopilot.navigation import G, SITL_TURN_EFFICIENCY, Airframe
 from ..autopilot.parameters import ARDUPLANE_DEFAULTS, VehicleParameters, read_parameters
-from ..vehicle import bank_for_radius_deg
 from ..sim.vehicle import SimulatedVehicle, VehicleSettings
 from ..upload.connection import read_signing_key
 from .options import (LAT_LON, UserError, apply, reports_errors, simulation_options,
@@ -38,7 +38,10 @@ def airframe_from(vehicle_params_file, airspeed_m_s, max_bank_deg, l1_period_s,
         if max_bank_deg is None:
             if not rho_m > 0:
                 raise UserError(f"the turn radius must be above 0 m, got {rho_m:g}")
-            max_bank_deg = bank_for_radius_deg(parameters.AIRSPEED_CRUISE, rho_m)
+            # the bank at which this airframe (turning at SITL_TURN_EFFICIENCY of the
+            # coordinated rate) turns at rho_m
+            speed = parameters.AIRSPEED_CRUISE
+            max_bank_deg = math.degrees(math.atan(speed ** 2 / (G * rho_m * SITL_TURN_EFFICIENCY)))
         if not 0 < max_bank_deg < 90:
             raise UserError(f"--max-bank must be between 0 and 90 deg, got {max_bank_deg:g}")
         parameters = replace(parameters, ROLL_LIMIT_DEG=max_bank_deg)

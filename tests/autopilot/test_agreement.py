@@ -1,9 +1,11 @@
 """The flight model against the recorded ArduPlane SITL flights (``tests/data/arduplane-sitl``).
 
-The limits are what the model reaches today (``docs/arduplane-agreement.md``) with a small
-margin, so a change that makes it agree less with the real vehicle fails here.  They are not
-yet the simulator issue's goals (timing 2 s; track 3 m median, 10 m max; closest approach 1 m
-median, 3 m max) everywhere: the rows that miss them are listed in that document.
+The limits are what the model reaches today (``docs/arduplane-agreement.md``) with a margin
+of about 20 %, so a change that makes it agree less with the real vehicle fails here.  The
+simulator issue's goals (timing 2 s; track 3 m median, 10 m max; closest approach 1 m median,
+3 m max) are met except where the limits below are wider: the document says which and why
+(``dtsp_u40_margin``'s 72 m is one place where ArduPlane looped back to a target it had
+passed more than its 5 m acceptance radius away, which the model passed within it).
 """
 
 from __future__ import annotations
@@ -18,15 +20,15 @@ DATA = Path(__file__).resolve().parents[1] / "data" / "arduplane-sitl"
 
 # case: (timing max s, track median m, track max m, closest |diff| median m, closest |diff| max m)
 LIMITS = {
-    "square": (1.5, 2.5, 18.0, 1.2, 3.8),
-    "zigzag": (2.2, 5.5, 24.0, 2.0, 3.0),
-    "circle_t2": (1.8, 4.0, 5.5, 4.2, 5.2),
-    "circle_t10": (1.6, 2.4, 5.5, 1.0, 2.3),
-    "circle_t40": (1.5, 3.5, 10.0, 1.1, 1.6),
-    "loiter_arcs": (2.7, 8.5, 18.0, 3.8, 4.3),
-    "dtsp_u40": (2.8, 5.2, 20.0, 4.4, 14.5),
-    "dtsp_u40_margin": (3.0, 6.0, 75.0, 6.0, 16.0),
-    "dtsp_dense60": (3.9, 6.2, 20.0, 3.7, 18.0),
+    "square": (1.2, 1.5, 4.5, 1.2, 2.0),
+    "zigzag": (1.5, 2.5, 7.5, 1.6, 2.2),
+    "circle_t2": (1.4, 0.8, 4.5, 0.6, 5.0),
+    "circle_t10": (1.3, 1.9, 7.0, 1.5, 7.5),
+    "circle_t40": (1.5, 0.9, 4.0, 0.8, 2.8),
+    "loiter_arcs": (2.3, 2.0, 9.5, 3.6, 4.0),
+    "dtsp_u40": (2.1, 1.3, 5.0, 1.0, 3.5),
+    "dtsp_u40_margin": (2.8, 1.3, 75.0, 1.1, 4.8),
+    "dtsp_dense60": (2.8, 0.8, 4.8, 1.0, 4.5),
 }
 
 
@@ -46,4 +48,4 @@ def test_the_model_flies_like_the_recorded_arduplane(case):
     assert result.approach_median_m <= closest_median
     assert result.approach_max_m <= closest_max
     # the model flies the whole mission, about as far as the real aircraft did
-    assert result.model_length_m == pytest.approx(result.real_length_m, rel=0.06)
+    assert result.model_length_m == pytest.approx(result.real_length_m, rel=0.02)
