@@ -1,6 +1,7 @@
 """``dtsp-mission plan`` from geodetic inputs to mission files, end to end."""
 
 import json
+import re
 import subprocess
 import sys
 from pathlib import Path
@@ -50,13 +51,33 @@ def test_site_example_to_every_format_and_a_plot(tmp_path):
     assert {t["altitude_m"] for t in targets} == {90.0, 70.0, 60.0}
 
 
-def test_default_budget_refuses_with_the_count_and_a_coarser_tolerance_fits(tmp_path):
-    result = run(SITE, "--radius", "80", "-o", tmp_path / "m.plan")
+def test_geometry_design_over_the_stock_budget_refuses_with_the_count_and_a_coarser_tolerance_fits(tmp_path):
+    result = run(SITE, "--radius", "80", "--design", "geometry", "-o", tmp_path / "m.plan")
     assert result.returncode == 2 and "items at a waypoint tolerance" in result.stderr
+    assert "holds 655" in result.stderr
     assert not (tmp_path / "m.plan").exists()
-    result = run(SITE, "--radius", "80", "--tolerance", "8", "-o", tmp_path / "m.plan")
+    result = run(SITE, "--radius", "80", "--design", "geometry", "--tolerance", "8", "-o",
+                 tmp_path / "m.plan")
     assert result.returncode == 0, result.stderr
-    assert len(json.loads((tmp_path / "m.plan").read_text())["mission"]["items"]) + 1 <= 700
+    assert len(json.loads((tmp_path / "m.plan").read_text())["mission"]["items"]) + 1 <= 655
+
+
+def test_the_guidance_design_fits_the_site_in_a_stock_ardupilot_and_reports_what_it_predicts(tmp_path):
+    result = run(SITE, "--radius", "80", "--airspeed", "22", "-o", tmp_path / "m.plan")
+    assert result.returncode == 0, result.stderr
+    items = json.loads((tmp_path / "m.plan").read_text())["mission"]["items"]
+    assert len(items) + 1 <= 655
+    targets = [i for i in items if i["command"] == 16 and i["params"][1] > 0]
+    assert len(targets) == 272                       # one waypoint per target
+    assert "designed for the autopilot's guidance" in result.stdout
+    assert "predicted flight" in result.stdout and "km of exact path" in result.stdout
+    if "predicted beyond --max-miss" in result.stderr:   # what could not be held is named
+        assert re.search(r"\d+ of 272 targets are predicted beyond --max-miss 5 m: \S+ \(\d", result.stderr)
+
+
+def test_max_items_beyond_mavlink_is_refused(tmp_path):
+    result = run(SITE, "--radius", "80", "--max-items", "70000", "-o", tmp_path / "m.plan")
+    assert result.returncode == 2 and "at most 65535 items" in result.stderr
 
 
 def test_random_targets_in_a_polygon_are_seeded(tmp_path):

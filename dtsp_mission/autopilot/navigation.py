@@ -197,8 +197,12 @@ class MissionFlight:
 
     def _following(self) -> LocalItem | None:
         """The next navigation item with a position after the current one."""
-        return next((i for i in self.items[self._index + 1:]
-                     if i.command in NAV_COMMANDS and not math.isnan(i.x_m)), None)
+        items = self.items
+        for k in range(self._index + 1, len(items)):
+            item = items[k]
+            if item.command in NAV_COMMANDS and not math.isnan(item.x_m):
+                return item
+        return None
 
     def _next_turn_deg(self) -> float:
         """Turn angle at the current waypoint, towards the next one (ArduPlane scales the
@@ -412,15 +416,28 @@ class MissionFlight:
             self._complete()
 
 
-def closest_approach_m(track_xy: np.ndarray, points_xy: np.ndarray, chunk: int = 256) -> np.ndarray:
-    """For each point, the smallest distance to the polyline ``track_xy`` (exact per segment)."""
-    a, b = track_xy[:-1], track_xy[1:]
-    d = b - a
+def closest_approach_m(track_xy: np.ndarray, points_xy: np.ndarray) -> np.ndarray:
+    """For each point, the smallest distance to the polyline ``track_xy`` (exact per segment).
+
+    A point's nearest segment has an end within (distance to the nearest vertex + the longest
+    segment) of it, so only the segments at the vertices in that ball are measured."""
+    from scipy.spatial import cKDTree
+    track = np.asarray(track_xy, dtype=float).reshape(-1, 2)
+    points = np.asarray(points_xy, dtype=float).reshape(-1, 2)
+    if len(track) == 0:
+        return np.full(len(points), np.inf)
+    if len(track) == 1:
+        return np.hypot(*(points - track[0]).T)
+    a, d = track[:-1], np.diff(track, axis=0)
     length2 = np.maximum((d * d).sum(axis=1), 1e-18)
-    result = np.empty(len(points_xy))
-    for start in range(0, len(points_xy), chunk):
-        p = points_xy[start:start + chunk, None, :]
-        t = np.clip(((p - a) * d).sum(axis=2) / length2, 0.0, 1.0)
-        nearest = a + t[..., None] * d
-        result[start:start + chunk] = np.sqrt(((p - nearest) ** 2).sum(axis=2)).min(axis=1)
+    longest = float(np.sqrt(length2.max()))
+    tree = cKDTree(track)
+    nearest, _ = tree.query(points)
+    result = np.empty(len(points))
+    for k, (p, radius) in enumerate(zip(points, nearest)):
+        vertices = np.asarray(tree.query_ball_point(p, radius + longest + 1e-9), dtype=np.int64)
+        segments = np.unique(np.clip(np.concatenate([vertices - 1, vertices]), 0, len(a) - 1))
+        t = np.clip(((p - a[segments]) * d[segments]).sum(axis=1) / length2[segments], 0.0, 1.0)
+        q = a[segments] + t[:, None] * d[segments]
+        result[k] = float(np.sqrt(((q - p) ** 2).sum(axis=1).min()))
     return result

@@ -17,19 +17,17 @@ from __future__ import annotations
 
 import csv
 import json
-import math
 from dataclasses import dataclass
 from pathlib import Path
 
 import numpy as np
 
-from ..autopilot import Autopilot, Command, stored_item
-from ..autopilot.navigation import (Airframe, LocalItem, MissionFlight, closest_approach_m,
-                                   local_items)
+from ..autopilot import Command
+from ..autopilot.navigation import Airframe, MissionFlight, closest_approach_m
 from ..autopilot.parameters import read_parameters
 from ..export import read_mission
 from ..frame import LocalFrame
-from ..upload.wire import first_mission_seq, to_wire
+from ..sim.predict import predict_flight
 
 
 #: The goals of the simulator issue: name -> (Agreement field, limit).
@@ -92,32 +90,12 @@ def _length(xy: np.ndarray) -> float:
 def fly_recorded_mission(folder: Path, airframe: Airframe | None = None, dt_s: float = 0.02,
                          ) -> tuple[MissionFlight, np.ndarray, LocalFrame]:
     """The model's flight of the case's mission (as ArduPilot stored it) with the case's
-    parameters: the flight and its track rows (time, x, y, altitude)."""
-    mission = read_mission(folder / "mission.plan")
-    home = mission.home
-    frame = LocalFrame(home.latitude_deg, home.longitude_deg)
-    wire = [stored_item(item, Autopilot.ARDUPILOTMEGA) for item in to_wire(mission)]
-    items = local_items(wire, frame, home.altitude_amsl_m)
-    if items[-1].command != Command.NAV_RETURN_TO_LAUNCH:
-        # ArduPlane: "Mission complete, changing mode to RTL"; the recordings go on 10 s.
-        items.append(LocalItem(len(items), Command.NAV_RETURN_TO_LAUNCH, math.nan, math.nan,
-                               items[-1].alt_m, (0.0, 0.0, 0.0, 0.0)))
-    first = first_mission_seq(Autopilot.ARDUPILOTMEGA)
-    takeoff = items[first]
-    heading = math.atan2(takeoff.y_m, takeoff.x_m)
+    parameters, on until :data:`RECORDED_AFTER_S` after the last item as recorded: the
+    flight, its track rows (time, x, y, altitude) and the local frame at home."""
     airframe = airframe or Airframe.from_parameters(read_parameters(folder / "params.parm"))
-    flight = MissionFlight(items, airframe, heading, first)
-    last_nav = max(i.seq for i in items if i.command != Command.NAV_RETURN_TO_LAUNCH
-                   and i.command in (Command.NAV_WAYPOINT, Command.NAV_LOITER_TURNS))
-    track = [(0.0, 0.0, 0.0, 0.0)]
-    stop_s = math.inf
-    while not flight.finished and flight.state.time_s < min(stop_s, 7200):
-        flight.step(dt_s)
-        s = flight.state
-        track.append((s.time_s, s.x_m, s.y_m, s.alt_m))
-        if stop_s == math.inf and any(seq == last_nav for seq, _ in flight.reached[-3:]):
-            stop_s = s.time_s + RECORDED_AFTER_S
-    return flight, np.array(track), frame
+    predicted = predict_flight(read_mission(folder / "mission.plan"), airframe, dt_s,
+                               RECORDED_AFTER_S, 7200.0)
+    return predicted.flight, predicted.track, predicted.frame
 
 
 def _closest_while_current(track: np.ndarray, reached: dict[int, float], seq: int,

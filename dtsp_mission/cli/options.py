@@ -4,6 +4,7 @@ the one place where library errors become CLI errors."""
 from __future__ import annotations
 
 import functools
+import sys
 from typing import Callable
 
 import click
@@ -86,24 +87,34 @@ mission_options = [
     click.option("--return", "return_mode", type=click.Choice(["rtl", "land", "none"]),
                  help="After the last target: RTL, a landing at home, or nothing "
                        "(default: rtl for ArduPilot, land for PX4)."),
+    click.option("--design", type=click.Choice(["guidance", "geometry"]), default="guidance",
+                 show_default=True,
+                 help="Waypoints for the autopilot's guidance: one per target, aimed so that "
+                      "ArduPlane's navigation (the flight model, with --vehicle-params) passes "
+                      "each within --max-miss, plus shaping waypoints where needed; or a "
+                      "polyline within --tolerance of the exact path (PX4 always)."),
+    click.option("--max-miss", "max_miss_m", type=float, default=5.0, show_default=True,
+                 metavar="METRES", help="How close the predicted flight must pass each target "
+                 "(the guidance design; with --simulate also the flight check's limit)."),
     click.option("--tolerance", "tolerance_m", type=float, metavar="METRES",
-                 help="Largest distance between the exact path and the waypoint polyline "
-                       "(default 2 % of rho; the discretiser uses a quarter of it when the "
-                       "item budget allows)."),
+                 help="--design geometry: largest distance between the exact path and the "
+                      "waypoint polyline (default 2 % of rho; a quarter of it when the item "
+                      "budget allows)."),
     click.option("--max-items", type=int, metavar="N",
-                 help="Mission slots of the vehicle (default 700 for ArduPilot, home included; "
-                       "500 for PX4)."),
+                 help="Mission slots of the vehicle (default a stock vehicle's: 655 for "
+                      "ArduPlane, home included; 500 for PX4; at most 65535)."),
 ]
 
 
 def mission_settings(autopilot, altitude_m, airspeed_m_s, home_deg, home_amsl_m,
-                     launch_bearing_deg, landing_bearing_deg, return_mode, tolerance_m,
-                     max_items):
-    """The :class:`MissionSettings` of the :data:`mission_options` values."""
+                     launch_bearing_deg, landing_bearing_deg, return_mode, design, max_miss_m,
+                     tolerance_m, max_items, vehicle=None):
+    """The :class:`MissionSettings` of the :data:`mission_options` values (``vehicle``: the
+    :class:`~dtsp_mission.autopilot.parameters.VehicleParameters` the mission is for)."""
     from ..mission import MissionSettings
     return MissionSettings(autopilot, altitude_m, airspeed_m_s, home_deg, home_amsl_m,
                            launch_bearing_deg, landing_bearing_deg, return_mode, tolerance_m,
-                           max_items)
+                           max_items, design=design, max_miss_m=max_miss_m, vehicle=vehicle)
 
 
 def apply(options: list) -> Callable:
@@ -163,12 +174,16 @@ simulation_options = [
 
 
 def progress_reporter(label: str):
-    """A ``progress(done, total)`` callback drawing a bar on stderr, and its closer."""
+    """A ``progress(done, total)`` callback drawing a bar on stderr, and its closer; nothing
+    is drawn when stderr is not a terminal (a log file gets no bar fragments)."""
     state: dict = {}
+    stream = sys.stderr
 
     def progress(done: int, total: int) -> None:
+        if not (hasattr(stream, "isatty") and stream.isatty()):
+            return
         if "bar" not in state:
-            state["bar"] = click.progressbar(length=total, label=label, file=click.get_text_stream("stderr"))
+            state["bar"] = click.progressbar(length=total, label=label, file=stream)
             state["bar"].__enter__()
             state["done"] = 0
         state["bar"].update(done - state["done"])

@@ -104,14 +104,12 @@ def _duration(seconds: float) -> str:
 @click.option("--simulate", is_flag=True, help="Fly the mission in the simulator (an ArduPlane "
               "with --vehicle-params, stock without) and print per-target miss distances.")
 @apply(simulation_options)
-@click.option("--max-miss", "max_miss_m", type=float, metavar="METRES",
-              help="With --simulate: exit with status 1 if a target is missed by more than this.")
 @reports_errors
 def plan(targets_file, random_count, area_file, seed, origin, rho_m, airspeed_m_s, max_bank_deg,
          altitude_m, home_deg, home_amsl_m, launch_bearing_deg, landing_bearing_deg, autopilot,
-         return_mode, tolerance_m, max_items, algorithm, region, fallback, outputs, format_name,
+         return_mode, design, max_miss_m, tolerance_m, max_items, algorithm, region, fallback, outputs, format_name,
          plot_file, connection, via, verify, signing_key_file, simulate, speedup, vehicle_params_file,
-         l1_period_s, max_miss_m) -> None:
+         l1_period_s) -> None:
     """Plan a Dubins tour through the targets and write it as a mission.
 
     TARGETS_FILE: CSV with lat,lon columns (optional alt, name), or local x,y metres (with
@@ -159,8 +157,9 @@ def plan(targets_file, random_count, area_file, seed, origin, rho_m, airspeed_m_
     product = tour
     if frame is not None:
         settings = mission_settings(autopilot, altitude_m, airspeed_m_s, home_deg, home_amsl_m,
-                                    launch_bearing_deg, landing_bearing_deg, return_mode,
-                                    tolerance_m, max_items)
+                                    launch_bearing_deg, landing_bearing_deg, return_mode, design,
+                                    max_miss_m, tolerance_m, max_items,
+                                    _designed_for(vehicle_params_file))
         product = build_mission(tour, frame, geodetic, settings)
         _report_mission(product)
     elif airspeed_m_s:
@@ -225,8 +224,19 @@ def _report_tour(tour, positions: np.ndarray, area_m: np.ndarray | None, elapsed
 def _report_mission(mission) -> None:
     summary = mission.summary
     flavour = "ArduPilot" if mission.autopilot == Autopilot.ARDUPILOTMEGA else "PX4"
-    click.echo(f"mission ({flavour}): {summary['items']} items, {summary['vehicle_slots']} "
-               f"vehicle slots; waypoints within {mission.tolerance_m:.2f} m of the exact path")
+    if "predicted_miss_m" in summary:
+        misses = np.asarray(summary["predicted_miss_m"])
+        click.echo(f"mission ({flavour}): {summary['items']} items ({summary['items'] / len(misses):.2f} "
+                   f"per target, {summary['shaping_waypoints']} shaping waypoints), "
+                   f"{summary['vehicle_slots']} vehicle slots; designed for the autopilot's "
+                   f"guidance: targets passed within median {np.median(misses):.1f} m, max "
+                   f"{misses.max():.1f} m in the flight model")
+        click.echo(f"  predicted flight {summary['predicted_flight_m'] / 1e3:,.2f} km against "
+                   f"{summary['planned_flight_m'] / 1e3:,.2f} km of exact path (take-off to the "
+                   "last target)")
+    else:
+        click.echo(f"mission ({flavour}): {summary['items']} items, {summary['vehicle_slots']} "
+                   f"vehicle slots; waypoints within {mission.tolerance_m:.2f} m of the exact path")
     line = f"flight: {summary['flight_length_m'] / 1e3:,.2f} km from take-off to the return"
     if "flight_time_s" in summary:
         line += f", {_duration(summary['flight_time_s'])} at {mission.cruise_speed_m_s:g} m/s"

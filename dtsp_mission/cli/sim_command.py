@@ -16,7 +16,7 @@ from ..autopilot.parameters import ARDUPLANE_DEFAULTS, VehicleParameters, read_p
 from ..sim.vehicle import SimulatedVehicle, VehicleSettings
 from ..upload.connection import read_signing_key
 from .options import (LAT_LON, UserError, apply, reports_errors, simulation_options,
-                      turn_radius_from, vehicle_options)
+                      vehicle_options)
 
 
 def airframe_from(vehicle_params_file, airspeed_m_s, max_bank_deg, l1_period_s,

@@ -19,7 +19,11 @@ from ..frame import LocalFrame
 from ..targets import GeoTargets
 from ..tour import Tour
 from ..vehicle import bearing_to_heading_rad, heading_to_bearing_deg
-from ..autopilot.commands import AUTOPILOTS, Autopilot, Command, Frame
+from ..autopilot.commands import AUTOPILOTS, Command, Frame
+from ..autopilot.navigation import Airframe
+from ..autopilot.parameters import ARDUPLANE_DEFAULTS, VehicleParameters
+from ..autopilot.storage import MAVLINK_MAX_ITEMS, capacity
+from .guidance import GuidanceDesign, design_waypoints
 from .discretise import waypoint_s
 from .flight_path import TAKEOFF_CLIMB_DEG, climb_distance_m, plan_flight_path
 from .model import FlightPath, Home, Mission, MissionItem, waypoint
@@ -28,10 +32,13 @@ from .model import FlightPath, Home, Mission, MissionItem, waypoint
 DEFAULT_TOLERANCE_RHO = 0.02
 #: The discretiser first tries this fraction of the tolerance, and coarsens only to fit.
 PREFERRED_TOLERANCE_FRACTION = 0.25
-#: Mission slots a vehicle holds by default: ArduPilot boards without mission storage on SD
-#: card hold about 700 (home included); PX4's default dataman holds 500.
-DEFAULT_MAX_ITEMS = {"ardupilot": 700, "px4": 500}
+#: Mission slots a stock vehicle holds (home included on ArduPilot): ArduPlane answers
+#: MISSION_COUNT 656 with NO_SPACE; PX4's default dataman holds 500.
+DEFAULT_MAX_ITEMS = {name: capacity(autopilot) for name, autopilot in AUTOPILOTS.items()}
 RETURN_MODES = ("rtl", "land", "none")
+#: How waypoints are chosen: for the autopilot's guidance (predicted with the flight model),
+#: or as a polyline within a tolerance of the exact path.
+DESIGNS = ("guidance", "geometry")
 
 
 @dataclass(frozen=True)
@@ -50,6 +57,9 @@ class MissionSettings:
     max_items: int | None = None              # default DEFAULT_MAX_ITEMS[autopilot]
     target_acceptance_m: float = 5.0          # acceptance radius of target waypoints
     takeoff_pitch_deg: float = TAKEOFF_CLIMB_DEG
+    design: str = "geometry"                  # guidance | geometry (see DESIGNS)
+    max_miss_m: float = 5.0                   # guidance: the predicted miss every target must hold
+    vehicle: VehicleParameters | None = None  # guidance: the autopilot's parameters (stock if None)
 
     def checked(self, rho_m: float) -> "MissionSettings":
         """The settings with defaults filled in, or :class:`InputError` saying what is wrong."""
@@ -71,6 +81,13 @@ class MissionSettings:
         max_items = DEFAULT_MAX_ITEMS[self.autopilot] if self.max_items is None else self.max_items
         if max_items < 1:
             raise InputError(f"--max-items must be at least 1, got {max_items}")
+        if max_items > MAVLINK_MAX_ITEMS:
+            raise InputError(f"--max-items {max_items} is more than MAVLink can address: a "
+                             f"mission has at most {MAVLINK_MAX_ITEMS} items (16-bit sequence numbers)")
+        if self.design not in DESIGNS:
+            raise InputError(f"unknown waypoint design {self.design!r}; choose {', '.join(DESIGNS)}")
+        if not (math.isfinite(self.max_miss_m) and self.max_miss_m > 0):
+            raise InputError(f"--max-miss must be a number above 0 m, got {self.max_miss_m!r}")
         if not (math.isfinite(self.home_altitude_amsl_m) and abs(self.home_altitude_amsl_m) < 1e4):
             raise InputError(f"home altitude must be a number of metres above sea level, got "
                              f"{self.home_altitude_amsl_m!r}")
@@ -117,6 +134,42 @@ def _fit_waypoints(path: FlightPath, rho_m: float, settings: MissionSettings) ->
     return chosen, high
 
 
+def _design_for_guidance(path: FlightPath, tour: Tour, frame: LocalFrame, targets: GeoTargets,
+                         settings: MissionSettings) -> GuidanceDesign:
+    """Waypoints for ArduPlane's guidance (:mod:`.guidance`) within the item budget; the
+    lead-out of a landing stays a geometric polyline."""
+    parameters = settings.vehicle or ARDUPLANE_DEFAULTS
+    airframe = Airframe.from_parameters(parameters, settings.airspeed_m_s)
+    tail = _tail_waypoints(path, tour.rho_m, settings)
+    budget = settings.max_items - _fixed_items(settings) - len(tail)
+    needed = len(tour.targets_m)
+    if budget < needed:
+        raise InputError(
+            f"the mission needs at least {needed + _fixed_items(settings) + len(tail)} items (one "
+            f"per target) but the vehicle holds {settings.max_items} (--max-items): allow more "
+            "if it has the space (ArduPilot with the mission on SD card holds about 4,300) or "
+            "split the targets into several missions")
+    head = ([(Command.DO_CHANGE_SPEED, (0.0, float(settings.airspeed_m_s), -1.0, 0.0))]
+            if settings.airspeed_m_s is not None else [])
+    local = frame.to_local(targets.latitudes_deg, targets.longitudes_deg)
+    altitudes = (np.full(len(local), settings.altitude_m) if targets.altitudes_m is None
+                 else np.asarray(targets.altitudes_m, dtype=float))
+    design = design_waypoints(path, local, altitudes, airframe, settings.max_miss_m, budget, head,
+                              settings.target_acceptance_m)
+    return replace(design, s_m=np.concatenate([[0.0], design.s_m, tail]),
+                   aim_m=np.vstack([path.chain.pose_at(np.array([0.0]))[:, :2], design.aim_m,
+                                    path.chain.pose_at(tail)[:, :2].reshape(-1, 2)]),
+                   target_of=np.concatenate([[-1], design.target_of, np.full(len(tail), -1)]))
+
+
+def _tail_waypoints(path: FlightPath, rho_m: float, settings: MissionSettings) -> np.ndarray:
+    """Arc lengths of the waypoints after the last target (the way to a landing approach)."""
+    if settings.return_mode != "land":
+        return np.zeros(0)
+    chosen = waypoint_s(path.chain, rho_m, path.target_s_m, settings.tolerance_m)
+    return chosen[chosen > path.tour_end_s_m + 1e-9]
+
+
 def build_mission(tour: Tour, frame: LocalFrame, targets: GeoTargets,
                   settings: MissionSettings) -> Mission:
     """The mission that flies ``tour`` (planned in ``frame``) from take-off to the return.
@@ -148,12 +201,35 @@ def build_mission(tour: Tour, frame: LocalFrame, targets: GeoTargets,
     if settings.launch_bearing_deg is None:
         notes.append(f"launch bearing not given: towards the first target "
                      f"({heading_to_bearing_deg(launch_heading):.0f} deg)")
-    chosen, tolerance = _fit_waypoints(path, tour.rho_m, settings)
-    if tolerance > PREFERRED_TOLERANCE_FRACTION * settings.tolerance_m:
-        notes.append(f"waypoints coarsened to a tolerance of {tolerance:.3g} m to fit "
-                     f"{settings.max_items} mission slots")
-    items = _items(path, chosen, frame, targets, settings, home_lat, home_lon)
+    design = None
+    if settings.design == "guidance" and settings.autopilot != "ardupilot":
+        notes.append("waypoints placed by geometry: the guidance design predicts ArduPlane's "
+                     "navigation, and PX4's is not modelled")
+        settings = replace(settings, design="geometry")
+    if settings.design == "guidance":
+        design = _design_for_guidance(path, tour, frame, targets, settings)
+        chosen, tolerance = design.s_m, float("nan")
+        held = design.predicted_miss_m <= settings.max_miss_m
+        if not held.all():
+            names = targets.names or tuple(f"target {i + 1}" for i in range(len(held)))
+            worst = np.argsort(-design.predicted_miss_m)[: int((~held).sum())]
+            listed = ", ".join(f"{names[i]} ({design.predicted_miss_m[i]:.1f} m)" for i in worst[:8])
+            more = f" and {len(worst) - 8} more" if len(worst) > 8 else ""
+            notes.append(f"{int((~held).sum())} of {len(held)} targets are predicted beyond "
+                         f"--max-miss {settings.max_miss_m:g} m: {listed}{more}")
+    else:
+        chosen, tolerance = _fit_waypoints(path, tour.rho_m, settings)
+        if tolerance > PREFERRED_TOLERANCE_FRACTION * settings.tolerance_m:
+            notes.append(f"waypoints coarsened to a tolerance of {tolerance:.3g} m to fit "
+                         f"{settings.max_items} mission slots")
+    items = _items(path, chosen, frame, targets, settings, home_lat, home_lon, design)
     summary = _summary(tour, path, items, settings, home_m)
+    if design is not None:
+        summary.update(predicted_miss_m=design.predicted_miss_m.tolist(),
+                       predicted_flight_m=design.predicted_length_m,
+                       planned_flight_m=design.planned_length_m,
+                       shaping_waypoints=sum(i.role == "shaping" for i in items),
+                       design_rounds=design.rounds)
     autopilot = AUTOPILOTS[settings.autopilot]
     mission = Mission(tuple(items), Home(home_lat, home_lon, settings.home_altitude_amsl_m),
                       autopilot, settings.airspeed_m_s, tour.rho_m, tolerance, frame, tour, path,
@@ -163,10 +239,20 @@ def build_mission(tour: Tour, frame: LocalFrame, targets: GeoTargets,
 
 
 def _items(path: FlightPath, chosen: np.ndarray, frame: LocalFrame, targets: GeoTargets,
-           settings: MissionSettings, home_lat: float, home_lon: float) -> list[MissionItem]:
-    latitudes, longitudes = frame.to_geodetic(path.chain.pose_at(chosen)[:, :2])
+           settings: MissionSettings, home_lat: float, home_lon: float,
+           design: GuidanceDesign | None = None) -> list[MissionItem]:
+    """The items; with a guidance ``design``, its aim points stand for the targets (where the
+    autopilot must be sent to pass over them) and its shaping waypoints are plain waypoints."""
+    points = path.chain.pose_at(chosen)[:, :2] if design is None else design.aim_m
+    latitudes, longitudes = frame.to_geodetic(points)
     altitudes = path.altitude_m(chosen)
-    target_at = {float(s): index for index, s in enumerate(path.target_s_m)}
+    if design is None:
+        target_at = {float(s): index for index, s in enumerate(path.target_s_m)}
+    else:
+        target_at = {}
+        for k, t in enumerate(design.target_of):
+            if t >= 0:
+                target_at[k] = int(t)
     items = [MissionItem(Command.NAV_TAKEOFF, Frame.GLOBAL_RELATIVE_ALT,
                          (float(settings.takeoff_pitch_deg), 0.0, 0.0, 0.0), float(latitudes[0]),
                          float(longitudes[0]), float(settings.altitude_m), True, "takeoff")]
@@ -175,10 +261,16 @@ def _items(path: FlightPath, chosen: np.ndarray, frame: LocalFrame, targets: Geo
                                  (0.0, float(settings.airspeed_m_s), -1.0, 0.0), role="speed"))
     for k in range(1, len(chosen)):
         s = float(chosen[k])
-        if s in target_at:
+        if design is not None and k in target_at:
+            index = target_at[k]
+            items.append(waypoint(latitudes[k], longitudes[k], altitudes[k], "target", index,
+                                  settings.target_acceptance_m))
+        elif design is None and s in target_at:
             index = target_at[s]
             items.append(waypoint(targets.latitudes_deg[index], targets.longitudes_deg[index],
                                   altitudes[k], "target", index, settings.target_acceptance_m))
+        elif design is not None and s <= path.tour_end_s_m:
+            items.append(waypoint(latitudes[k], longitudes[k], altitudes[k], "shaping"))
         elif settings.return_mode == "land" and k == len(chosen) - 1:
             items.append(waypoint(latitudes[k], longitudes[k], path.altitudes_at_s[1][-1],
                                   "approach"))

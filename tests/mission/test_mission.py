@@ -145,7 +145,7 @@ def test_px4_defaults_to_a_landing_and_warns_about_rtl():
 def test_any_small_instance_gives_a_valid_flight_path_and_items(count, seed, rho, span,
                                                                 tolerance_fraction):
     mission = make_mission(count, seed=seed, rho_m=rho, span_m=span,
-                           tolerance_m=tolerance_fraction * rho, max_items=100_000)
+                           tolerance_m=tolerance_fraction * rho, max_items=65_535)
     path = mission.path
     assert check_path(path.chain, rho, mission.tour.targets_m, path.target_s_m, closed=False).ok
     chosen = waypoint_s(path.chain, rho, path.target_s_m, mission.tolerance_m)

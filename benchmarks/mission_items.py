@@ -1,0 +1,116 @@
+"""Items per target and predicted misses of the two waypoint designs, per kind of site;
+writes ``docs/mission-items.md``.
+
+    python benchmarks/mission_items.py [--seeds 2] [--out docs/mission-items.md]
+
+Every mission is flown by the ArduPlane flight model (stock parameters, 22 m/s; the model
+agrees with recorded ArduPlane flights, ``docs/arduplane-agreement.md``) from rest at home;
+a target's miss is the least distance of the predicted track (after take-off) to it.
+``geometry`` is the waypoint polyline within the default tolerance of the exact path (given
+room for 4,000 items); ``guidance`` is the default design within a stock ArduPlane's 655 slots.
+"""
+
+from __future__ import annotations
+
+import argparse
+import time
+from dataclasses import replace
+from pathlib import Path
+
+import numpy as np
+
+from dtsp_mission.api import plan_tour
+from dtsp_mission.autopilot.navigation import Airframe, closest_approach_m
+from dtsp_mission.errors import InputError
+from dtsp_mission.files import write_atomic
+from dtsp_mission.frame import LocalFrame
+from dtsp_mission.mission import MissionSettings, build_mission
+from dtsp_mission.sim.predict import predict_flight
+from dtsp_mission.targets import read_targets
+from dtsp_mission.targets.model import local_targets
+
+ROOT = Path(__file__).resolve().parents[1]
+RHO_M, AIRSPEED_M_S, ALTITUDE_M = 80.0, 22.0, 120.0
+CENTRE = (47.3977, 8.5456)
+
+
+def _site(kind: str, n: int, seed: int):
+    rng = np.random.default_rng(seed)
+    if kind == "uniform":
+        side = 350.0 * np.sqrt(n)            # the density of the recorded dtsp_u40 flight
+        points = rng.uniform(-side / 2, side / 2, (n, 2))
+    elif kind == "dense":
+        points = rng.uniform(-750.0, 750.0, (n, 2))
+    elif kind == "clustered":                # Gaussian clusters among sparse targets
+        centres = rng.uniform(-2500.0, 2500.0, (max(2, n // 40), 2))
+        clustered = centres[rng.integers(0, len(centres), n * 3 // 4)] + rng.normal(0, 120.0, (n * 3 // 4, 2))
+        points = np.vstack([clustered, rng.uniform(-3000.0, 3000.0, (n - len(clustered), 2))])
+    else:
+        raise ValueError(kind)
+    return local_targets(points).to_geodetic(LocalFrame(*CENTRE))
+
+
+def _evaluate(mission, targets, airframe) -> dict:
+    flight = predict_flight(mission.for_vehicle(), airframe, 0.02)
+    track = flight.track
+    after = track[:, 0] >= flight.reached.get(1, 0.0)
+    xy = flight.frame.to_local(targets.latitudes_deg, targets.longitudes_deg)
+    miss = closest_approach_m(track[after, 1:3], xy)
+    return {"items": len(mission.items), "per_target": len(mission.items) / len(xy),
+            "median": float(np.median(miss)), "p95": float(np.percentile(miss, 95)),
+            "max": float(miss.max()), "beyond5": int((miss > 5.0).sum())}
+
+
+def main() -> None:
+    parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    parser.add_argument("--seeds", type=int, default=2)
+    parser.add_argument("--out", type=Path, default=ROOT / "docs" / "mission-items.md")
+    args = parser.parse_args()
+    airframe = Airframe.from_parameters(airspeed_m_s=AIRSPEED_M_S)
+    sites = [("bundled site (272)", None, 0)]
+    for kind, sizes in (("uniform", (100, 200, 400)), ("clustered", (100, 400)), ("dense", (100, 200))):
+        sites += [(f"{kind} {n}", (kind, n), s) for n in sizes for s in range(args.seeds)]
+    rows = []
+    for label, spec, seed in sites:
+        targets = (read_targets(ROOT / "examples" / "site-inspection.csv") if spec is None
+                   else _site(*spec, seed))
+        tour, frame = plan_tour(targets, RHO_M)
+        base = MissionSettings(altitude_m=ALTITUDE_M, airspeed_m_s=AIRSPEED_M_S,
+                               home_deg=None if spec is None else CENTRE)
+        row = [label if spec is None else f"{label} (seed {seed})", len(targets)]
+        for design, budget in (("geometry", 4000), ("guidance", None)):
+            started = time.perf_counter()
+            try:
+                mission = build_mission(tour, frame, targets,
+                                        replace(base, design=design, max_items=budget))
+            except InputError as error:
+                row.append({"error": str(error)})
+                continue
+            result = _evaluate(mission, targets, airframe)
+            result["seconds"] = time.perf_counter() - started
+            if design == "guidance":
+                result["predicted_km"] = mission.summary["predicted_flight_m"] / 1e3
+                result["planned_km"] = mission.summary["planned_flight_m"] / 1e3
+            row.append(result)
+        rows.append(row)
+        print(label, seed, row[2:], flush=True)
+    lines = ["| site | targets | geometry: items/target | geometry: miss median / p95 / max m | "
+             "guidance: items/target | guidance: miss median / p95 / max m | guidance: targets > 5 m | "
+             "guidance: predicted / planned km | design time s |", "|---|---:|---:|---|---:|---|---:|---|---:|"]
+    for label, n, geometry, guidance in rows:
+        g = ("-" if "error" in geometry else f"{geometry['per_target']:.2f}",
+             "-" if "error" in geometry else f"{geometry['median']:.1f} / {geometry['p95']:.1f} / {geometry['max']:.1f}")
+        lines.append(f"| {label} | {n} | {g[0]} | {g[1]} | {guidance['per_target']:.2f} | "
+                     f"{guidance['median']:.1f} / {guidance['p95']:.1f} / {guidance['max']:.1f} | "
+                     f"{guidance['beyond5']} | {guidance['predicted_km']:.1f} / {guidance['planned_km']:.1f} | "
+                     f"{guidance['seconds']:.0f} |")
+    intro = (__doc__.split("\n\n", 2)[2] if __doc__.count("\n\n") >= 2 else "")
+    text = ("# Mission items per target, and how close the predicted flight passes\n\n"
+            "Made by `benchmarks/mission_items.py` (rho 80 m, 22 m/s, 120 m; seeds 0.."
+            f"{args.seeds - 1}).\n\n" + intro.strip() + "\n\n" + "\n".join(lines) + "\n")
+    write_atomic(args.out, text)
+    print(text)
+
+
+if __name__ == "__main__":
+    main()

@@ -1,0 +1,60 @@
+"""The simulated vehicle's flight without the network: a mission, as the autopilot stores it,
+flown by the flight model from rest at home, in the local frame at home.
+
+The same items the simulated vehicle would fly after an upload (stored as the autopilot keeps
+them, ArduPilot's home slot skipped), so an offline prediction and ``fly`` agree.
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass
+
+import numpy as np
+
+from ..autopilot import Command, stored_item
+from ..autopilot.navigation import Airframe, LocalItem, MissionFlight, local_items
+from ..frame import LocalFrame
+from ..mission import VehicleMission
+from ..upload.wire import first_mission_seq, to_wire
+
+_FLOWN = (Command.NAV_WAYPOINT, Command.NAV_LOITER_TURNS)
+
+
+@dataclass(frozen=True)
+class PredictedFlight:
+    """Track rows (time s, x, y, altitude above home; local frame at home), reach times by
+    vehicle seq, and the frame."""
+
+    track: np.ndarray
+    reached: dict[int, float]
+    frame: LocalFrame
+    flight: MissionFlight
+
+
+def predict_flight(mission: VehicleMission, airframe: Airframe, dt_s: float = 0.02,
+                   after_last_s: float = 0.0, limit_s: float = 36000.0) -> PredictedFlight:
+    """Fly ``mission`` until its last waypoint or loiter is reached, then ``after_last_s`` more
+    (in RTL, as ArduPlane goes on after a mission without one)."""
+    home = mission.home
+    frame = LocalFrame(home.latitude_deg, home.longitude_deg)
+    wire = [stored_item(item, mission.autopilot) for item in to_wire(mission)]
+    items = local_items(wire, frame, home.altitude_amsl_m)
+    if items[-1].command != Command.NAV_RETURN_TO_LAUNCH:
+        items.append(LocalItem(len(items), Command.NAV_RETURN_TO_LAUNCH, math.nan, math.nan,
+                               items[-1].alt_m, (0.0, 0.0, 0.0, 0.0)))
+    first = first_mission_seq(mission.autopilot)
+    ahead = next((i for i in items[first:] if not math.isnan(i.x_m)
+                  and math.hypot(i.x_m, i.y_m) > 1.0), None)
+    heading = math.atan2(ahead.y_m, ahead.x_m) if ahead is not None else 0.0
+    flight = MissionFlight(items, airframe, heading, first)
+    last = max((i.seq for i in items if i.command in _FLOWN), default=first)
+    track = [(0.0, 0.0, 0.0, 0.0)]
+    stop_s = math.inf
+    while not flight.finished and flight.state.time_s < min(stop_s, limit_s):
+        flight.step(dt_s)
+        s = flight.state
+        track.append((s.time_s, s.x_m, s.y_m, s.alt_m))
+        if stop_s == math.inf and flight.reached and flight.reached[-1][0] >= last:
+            stop_s = s.time_s + after_last_s
+    return PredictedFlight(np.array(track), dict(flight.reached), frame, flight)
