@@ -29,6 +29,19 @@ def require_matplotlib() -> None:
         raise InputError("--plot needs matplotlib: pip install 'dtsp-mission[plot]'") from None
 
 
+#: Picture formats by file extension (matplotlib's writers).
+PLOT_FORMATS = {".png": "png", ".svg": "svg", ".pdf": "pdf", ".jpg": "jpg", ".jpeg": "jpg"}
+
+
+def plot_format(path) -> str:
+    """The picture format of ``path`` from its extension, or :class:`InputError`."""
+    suffix = Path(path).suffix.lower()
+    if suffix not in PLOT_FORMATS:
+        raise InputError(f"{path}: a plot is written as {', '.join(PLOT_FORMATS)}; "
+                         f"{suffix or 'no extension'} is none of them")
+    return PLOT_FORMATS[suffix]
+
+
 def draw_plan(product: Mission | Tour, path: str | os.PathLike,
               area_m: np.ndarray | None = None, title: str = "") -> Path:
     """Write a PNG of ``product`` to ``path`` (atomically)."""
@@ -71,6 +84,6 @@ def draw_plan(product: Mission | Tour, path: str | os.PathLike,
     axes.grid(True, linewidth=0.3)
     axes.legend(loc="upper right", fontsize=8)
     buffer = io.BytesIO()
-    figure.savefig(buffer, format="png", bbox_inches="tight")
+    figure.savefig(buffer, format=plot_format(path), bbox_inches="tight")
     plt.close(figure)
     return write_atomic(path, buffer.getvalue())

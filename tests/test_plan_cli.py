@@ -107,3 +107,48 @@ def test_duplicates_are_merged_and_reported(tmp_path):
     result = run(str(targets), "--radius", "50", "-o", str(tmp_path / "t.json"))
     assert result.returncode == 0 and "1 duplicate targets merged" in result.stderr
     assert len(read_tour(tmp_path / "t.json").targets_m) == 30
+
+
+# Defects a new user hit (issue 16): each a clear message and exit 2, or the right file.
+
+SITE = Path(__file__).parents[1] / "examples" / "site-inspection.csv"
+AREA = Path(__file__).parents[1] / "examples" / "survey-area.geojson"
+
+
+def test_a_region_that_is_no_number_or_name_is_a_clear_error(tmp_path):
+    result = run(str(EXAMPLE), "--radius", "80", "--region", "foo", "-o", str(tmp_path / "t.json"))
+    assert result.returncode == 2 and "Traceback" not in result.stderr
+    assert "region 'foo' is not 'bounding', 'min-area' or a sweep heading" in result.stderr
+
+
+def test_a_negative_seed_is_refused_by_the_option(tmp_path):
+    result = run("--random", "10", "--area", str(AREA), "--radius", "80", "--seed", "-1",
+                 "-o", str(tmp_path / "t.json"))
+    assert result.returncode == 2 and "Traceback" not in result.stderr and "--seed" in result.stderr
+
+
+def test_a_targets_file_beside_random_is_refused_not_ignored(tmp_path):
+    result = run(str(SITE), "--random", "10", "--area", str(AREA), "--radius", "80",
+                 "-o", str(tmp_path / "t.json"))
+    assert result.returncode == 2 and "not both" in result.stderr
+
+
+def test_a_missing_output_folder_is_found_before_planning_and_nothing_is_written(tmp_path):
+    ok, bad = tmp_path / "ok.json", tmp_path / "nope" / "m.json"
+    result = run(str(EXAMPLE), "--radius", "80", "-o", str(ok), "-o", str(bad))
+    assert result.returncode == 2 and "does not exist" in result.stderr
+    assert "targets" not in result.stdout          # refused before any planning
+    assert not ok.exists()
+
+
+@pytest.mark.parametrize("suffix, magic", [(".svg", b"<?xml"), (".pdf", b"%PDF"), (".png", b"\x89PNG")])
+def test_the_plot_is_written_in_the_format_of_its_extension(tmp_path, suffix, magic):
+    picture = tmp_path / f"m{suffix}"
+    result = run(str(EXAMPLE), "--radius", "80", "-o", str(tmp_path / "t.json"), "--plot", str(picture))
+    assert result.returncode == 0, result.stderr
+    assert picture.read_bytes().startswith(magic)
+
+
+def test_an_unknown_plot_format_is_refused_before_planning(tmp_path):
+    result = run(str(EXAMPLE), "--radius", "80", "--plot", str(tmp_path / "m.gif"))
+    assert result.returncode == 2 and ".gif is none of them" in result.stderr

@@ -32,7 +32,7 @@ def reports_errors(function: Callable) -> Callable:
 radius_option = click.option(
     "--radius", "rho_m", type=float, required=True, metavar="METRES",
     help="Minimum turn radius rho of the aircraft, in metres.")
-seed_option = click.option("--seed", type=int, default=0, show_default=True,
+seed_option = click.option("--seed", type=click.IntRange(min=0), default=0, show_default=True,
                            help="Seed of every random choice; the same seed gives the same result.")
 
 

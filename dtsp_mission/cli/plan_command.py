@@ -2,7 +2,9 @@
 
 from __future__ import annotations
 
+import os
 import time
+from pathlib import Path
 
 import click
 import numpy as np
@@ -13,9 +15,12 @@ from ..export import exporter_for
 from ..frame import LocalFrame
 from ..mission import Autopilot, build_mission
 from ..planning import TilingUnavailable, get_planner, planners
+from ..mission.build import targets_beyond, with_turn_margin
 from ..planning.base import MERGE_RESOLUTION_RHO
 from ..planning.lower_bounds import lower_bound
-from ..plot import draw_plan, require_matplotlib
+from ..files import write_atomic
+from ..planning.rbta import region_heading_deg
+from ..plot import draw_plan, plot_format, require_matplotlib
 from ..targets import GeoTargets, Targets, random_targets, read_targets
 from ..targets.geojson_file import read_geojson
 from .options import (LAT_LON, UserError, apply, link_options, mission_options,
@@ -23,8 +28,27 @@ from .options import (LAT_LON, UserError, apply, link_options, mission_options,
                       turn_radius_from, vehicle_options)
 
 
+def _check_writable(paths) -> None:
+    """UserError, before any work, for an output whose folder does not exist or is not
+    writable, or two outputs to the same file."""
+    seen = set()
+    for path in paths:
+        resolved = Path(path).resolve()
+        if resolved in seen:
+            raise UserError(f"{path} is given twice as an output")
+        seen.add(resolved)
+        folder = resolved.parent
+        if not folder.is_dir():
+            raise UserError(f"{path}: the folder {folder} does not exist")
+        if not os.access(folder, os.W_OK):
+            raise UserError(f"{path}: the folder {folder} is not writable")
+
+
 def _targets(targets_file: str | None, random_count: int | None, area_file: str | None,
              seed: int) -> GeoTargets | Targets:
+    if random_count is not None and targets_file is not None and area_file is not None:
+        raise UserError(f"give either a TARGETS_FILE ({targets_file}) or --random N with --area, "
+                        "not both: --random draws its own targets")
     if random_count is None:
         if targets_file is None:
             raise UserError("give a TARGETS_FILE, or --random N with --area")
@@ -95,8 +119,8 @@ def _duration(seconds: float) -> str:
               help="Write here; the format follows the extension (.plan, .waypoints, .geojson, "
                    ".json tour) unless --format says. Repeatable.")
 @click.option("--format", "format_name", help="Output format for every -o, whatever its extension.")
-@click.option("--plot", "plot_file", type=click.Path(dir_okay=False), metavar="PNG",
-              help="Draw targets, path and waypoints to this PNG file.")
+@click.option("--plot", "plot_file", type=click.Path(dir_okay=False), metavar="FILE",
+              help="Draw targets, path and waypoints to this picture (.png, .svg, .pdf, .jpg).")
 @click.option("--upload", "connection", metavar="CONNECTION",
               help="Upload the mission to this vehicle after writing the files "
                    "(udpout:HOST:PORT, ...); see `dtsp-mission upload`.")
@@ -120,6 +144,10 @@ def plan(targets_file, random_count, area_file, seed, origin, rho_m, airspeed_m_
     writers = [(output, exporter_for(output, format_name)) for output in outputs]
     if plot_file:
         require_matplotlib()
+        plot_format(plot_file)
+    _check_writable([*outputs, *([plot_file] if plot_file else [])])
+    if algorithm in ("rbta", "auto") and region not in ("bounding", "min-area"):
+        region_heading_deg(region)
     rho, rho_source = turn_radius_from(rho_m, airspeed_m_s, max_bank_deg)
     targets = _targets(targets_file, random_count, area_file, seed)
     if len(targets) < 2:
@@ -161,12 +189,25 @@ def plan(targets_file, random_count, area_file, seed, origin, rho_m, airspeed_m_
                                     max_miss_m, tolerance_m, max_items,
                                     _designed_for(vehicle_params_file))
         product = build_mission(tour, frame, geodetic, settings)
+        if "predicted_miss_m" in product.summary:
+            planner = get_planner(algorithm, **parameters)
+            widened = with_turn_margin(product, lambda r: planner.plan(local.positions_m, r),
+                                       geodetic, settings)
+            if widened is not product:
+                click.echo(f"note: planned with a turn radius of {widened.rho_m:g} m instead of "
+                           f"{rho:g} m so that the autopilot's guidance can hold the turns: "
+                           f"{targets_beyond(product, max_miss_m)} -> "
+                           f"{targets_beyond(widened, max_miss_m)} targets predicted beyond "
+                           "--max-miss", err=True)
+                product, tour = widened, widened.tour
         _report_mission(product)
     elif airspeed_m_s:
         click.echo(f"flight time of the tour at {airspeed_m_s:g} m/s: "
                    f"{_duration(tour.length_m / airspeed_m_s)}")
-    for output, writer in writers:
-        writer.write(product, output)
+    # All or nothing: every file is rendered before the first is written.
+    rendered = [(output, writer, writer.render_for(product, output)) for output, writer in writers]
+    for output, writer, content in rendered:
+        write_atomic(output, content)
         click.echo(f"wrote {output} ({writer.description})")
     if plot_file:
         draw_plan(product, plot_file, area_m)
@@ -175,13 +216,13 @@ def plan(targets_file, random_count, area_file, seed, origin, rho_m, airspeed_m_
         raise UserError("--upload and --simulate need a mission in degrees: targets in lat/lon, "
                         "or local x/y with --origin")
     if simulate:
-        from ..sim.fly import targets_in
+        from ..sim.fly import planned_targets
         from .fly_command import run_flight_check
         from .sim_command import airframe_from
         airframe, _, _ = airframe_from(vehicle_params_file, airspeed_m_s, None, l1_period_s)
         mission = product.for_vehicle()
-        run_flight_check(mission, targets_in(mission, product.target_names), airframe, via,
-                         speedup, max_miss_m, max_items)
+        run_flight_check(mission, planned_targets(product), airframe, via, speedup, max_miss_m,
+                         max_items)
     if connection:
         from .upload_command import run_upload
         run_upload(product.for_vehicle(), connection, via, verify, signing_key_file,

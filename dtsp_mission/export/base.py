@@ -41,10 +41,15 @@ class Exporter:
     needs_mission: bool = True
 
     def write(self, product: Mission | Tour, path: str | os.PathLike) -> Path:
+        return write_atomic(path, self.render_for(product, path))
+
+    def render_for(self, product: Mission | Tour, path: str | os.PathLike) -> str | bytes:
+        """The file's content for ``path``, or :class:`InputError` if this format needs a
+        mission and ``product`` is a bare tour."""
         if self.needs_mission and not isinstance(product, Mission):
             raise InputError(f"{path}: a {self.description or self.name} needs a mission in "
                              "degrees; give targets in lat/lon, or local x/y with --origin")
-        return write_atomic(path, self.render(product))
+        return self.render(product)
 
     def render(self, product: Mission | Tour) -> str | bytes:
         """The complete file content."""

@@ -38,6 +38,7 @@ def geojson_dict(mission: Mission) -> dict:
                            {"kind": "home", "altitude_amsl_m": home.altitude_amsl_m}))
     item_of_target = mission.target_items
     rank = mission.visit_numbers
+    latitudes, longitudes = mission.target_positions_deg
     for target, item_index in enumerate(item_of_target):
         item = mission.items[item_index]
         properties = {"kind": "target", "target": target, "visit": int(rank[target]),
@@ -45,7 +46,7 @@ def geojson_dict(mission: Mission) -> dict:
                       "s_m": float(path.target_s_m[target])}
         if mission.target_names is not None:
             properties["name"] = mission.target_names[target]
-        features.append(_point(item.latitude_deg, item.longitude_deg, properties))
+        features.append(_point(latitudes[target], longitudes[target], properties))
     for index, item in enumerate(mission.items):
         if item.has_position:
             features.append(_point(item.latitude_deg, item.longitude_deg,

@@ -11,10 +11,11 @@ from __future__ import annotations
 
 import math
 from dataclasses import dataclass, replace
+from typing import Callable
 
 import numpy as np
 
-from ..errors import InputError
+from ..errors import DtspError, InputError
 from ..frame import LocalFrame
 from ..targets import GeoTargets
 from ..tour import Tour
@@ -233,7 +234,8 @@ def build_mission(tour: Tour, frame: LocalFrame, targets: GeoTargets,
     autopilot = AUTOPILOTS[settings.autopilot]
     mission = Mission(tuple(items), Home(home_lat, home_lon, settings.home_altitude_amsl_m),
                       autopilot, settings.airspeed_m_s, tour.rho_m, tolerance, frame, tour, path,
-                      targets.names, tuple(notes), summary)
+                      targets.names, tuple(notes), summary,
+                      (np.asarray(targets.latitudes_deg), np.asarray(targets.longitudes_deg)))
     summary["vehicle_slots"] = mission.vehicle_item_count()
     return mission
 
@@ -286,6 +288,38 @@ def _items(path: FlightPath, chosen: np.ndarray, frame: LocalFrame, targets: Geo
         items.append(MissionItem(Command.NAV_LAND, Frame.GLOBAL_RELATIVE_ALT, (0.0, 0.0, 0.0, 0.0),
                                  home_lat, home_lon, 0.0, True, "land"))
     return items
+
+
+#: Turn radii tried for the guidance design when targets stay beyond --max-miss, in rho: a
+#: wider planned turn is one ArduPlane's L1 guidance can hold (docs/mission-items.md).
+GUIDANCE_MARGINS = (1.3, 1.6)
+
+
+def targets_beyond(mission: Mission, max_miss_m: float) -> int:
+    """How many targets a guidance-designed mission is predicted to miss by more than this."""
+    return sum(m > max_miss_m for m in mission.summary.get("predicted_miss_m", ()))
+
+
+def with_turn_margin(mission: Mission, replan: Callable[[float], Tour], targets: GeoTargets,
+                     settings: MissionSettings) -> Mission:
+    """``mission`` (guidance design), or the mission of a tour planned with a wider turn radius
+    (``replan(rho)``, :data:`GUIDANCE_MARGINS`) if that holds more targets within
+    ``settings.max_miss_m`` (ties: the shorter predicted flight)."""
+    def key(candidate: Mission) -> tuple[int, float]:
+        return (targets_beyond(candidate, settings.max_miss_m),
+                candidate.summary["predicted_flight_m"])
+    best = mission
+    for factor in GUIDANCE_MARGINS:
+        if targets_beyond(best, settings.max_miss_m) == 0:
+            break
+        try:
+            candidate = build_mission(replan(mission.rho_m * factor), mission.frame, targets,
+                                      settings)
+        except DtspError:
+            continue
+        if key(candidate) < key(best):
+            best = candidate
+    return best
 
 
 def _summary(tour: Tour, path: FlightPath, items: list[MissionItem],

@@ -104,12 +104,21 @@ class Mission:
     target_names: tuple[str, ...] | None = None
     notes: tuple[str, ...] = ()        # decisions the user should know about
     summary: dict[str, Any] = field(default_factory=dict)
+    targets_deg: tuple[np.ndarray, np.ndarray] | None = None   # the input's latitudes, longitudes
 
     @property
     def target_items(self) -> list[int]:
         """Index (in ``items``) of the waypoint of each target, in target order."""
         index = {item.target: k for k, item in enumerate(self.items) if item.role == "target"}
         return [index[t] for t in range(len(self.tour.targets_m))]
+
+    @property
+    def target_positions_deg(self) -> tuple[np.ndarray, np.ndarray]:
+        """Latitudes and longitudes of the targets themselves, in target order (a target's
+        waypoint may stand elsewhere: the aim point of the guidance design)."""
+        if self.targets_deg is not None:
+            return self.targets_deg
+        return self.frame.to_geodetic(self.tour.targets_m)
 
     @property
     def visit_numbers(self) -> np.ndarray:

@@ -31,6 +31,7 @@ import math
 import numpy as np
 
 from ..dubins import chain_of_paths, shortest_length, shortest_words
+from ..errors import InputError
 from ..segments import SegmentChain
 from ..tour import Tour, tour_through_poses
 from ..tour.model import snap_visits
@@ -213,6 +214,18 @@ def _phase(local: np.ndarray, remaining: np.ndarray, tiling: BeadTiling, bead_ro
     return chain, serviced, visit_s, report
 
 
+def region_heading_deg(choice) -> float:
+    """A ``region`` parameter that is a sweep heading, in degrees, or :class:`InputError`."""
+    try:
+        heading = float(choice)
+    except (TypeError, ValueError):
+        raise InputError(f"region {choice!r} is not 'bounding', 'min-area' or a sweep heading in "
+                         "degrees") from None
+    if not math.isfinite(heading):
+        raise InputError(f"region heading must be a finite number of degrees, got {choice!r}")
+    return heading
+
+
 class RBTAPlanner(Planner):
     """The Recursive Bead-Tiling Algorithm, then the Alternating Algorithm for leftovers.
 
@@ -230,7 +243,7 @@ class RBTAPlanner(Planner):
             return bounding_region(targets_m)
         if choice == "min-area":
             return minimum_area_region(targets_m)
-        return bounding_region(targets_m, math.radians(float(choice)))
+        return bounding_region(targets_m, math.radians(region_heading_deg(choice)))
 
     def _plan(self, targets_m: np.ndarray, rho_m: float, region: Region | None) -> Tour:
         n = len(targets_m)

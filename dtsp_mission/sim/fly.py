@@ -35,6 +35,18 @@ class Targets:
     names: tuple[str, ...]
 
 
+def planned_targets(mission) -> Targets:
+    """The targets of a planned :class:`~dtsp_mission.mission.Mission` themselves (not their
+    waypoints, which the guidance design aims elsewhere), in visiting order, with the
+    altitude of their waypoint and their names."""
+    chosen = [item for item in mission.items if item.role == "target"]
+    latitudes, longitudes = mission.target_positions_deg
+    index = np.array([item.target for item in chosen], dtype=np.int64)
+    names = mission.target_names
+    return Targets(latitudes[index], longitudes[index], np.array([i.altitude_m for i in chosen]),
+                   tuple(names[i] if names else f"target {i + 1}" for i in index))
+
+
 def targets_in(mission: VehicleMission, names: tuple[str, ...] | None = None) -> Targets:
     """The mission's targets in visiting order: its ``target`` items (named from ``names``
     by target index), or -- for items read from a file, which carry no roles -- every

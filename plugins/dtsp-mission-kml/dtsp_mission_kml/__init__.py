@@ -87,13 +87,14 @@ def kml_document(mission: Mission) -> ET.Element:
     target_folder = ET.SubElement(document, "Folder")
     _text(target_folder, "name", "Targets")
     visit_rank = mission.visit_numbers
+    latitudes, longitudes = mission.target_positions_deg
     for target, item_index in enumerate(mission.target_items):
         item = mission.items[item_index]
         name = mission.target_names[target] if mission.target_names is not None else f"T{target}"
         _point(target_folder, name,
                f"visit {visit_rank[target] + 1} of {len(visit_rank)}; overfly at "
                f"{item.altitude_m:g} m above home; mission item {item_index}",
-               "#target", item.latitude_deg, item.longitude_deg)
+               "#target", latitudes[target], longitudes[target])
 
     home_folder = ET.SubElement(document, "Folder")
     _text(home_folder, "name", "Home")

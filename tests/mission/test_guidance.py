@@ -1,0 +1,66 @@
+"""Missions designed for the autopilot's guidance: one aimed waypoint per target, checked by
+flying the written mission again, independently, through the simulated vehicle's own path
+(storage, geodetic round trip, the flight model)."""
+
+from __future__ import annotations
+
+import numpy as np
+import pytest
+
+from dtsp_mission.autopilot.navigation import Airframe, closest_approach_m
+from dtsp_mission.errors import InputError
+from dtsp_mission.frame import LocalFrame
+from dtsp_mission.mission import MissionSettings, build_mission
+from dtsp_mission.planning import get_planner
+from dtsp_mission.sim.predict import predict_flight
+from dtsp_mission.targets.model import local_targets
+
+CENTRE = (47.3977, 8.5456)
+
+
+def sparse_site(count=30, seed=2, side=3000.0):
+    frame = LocalFrame(*CENTRE)
+    positions = np.random.default_rng(seed).uniform(-side / 2, side / 2, (count, 2))
+    targets = local_targets(positions).to_geodetic(frame)
+    tour = get_planner("auto").plan(targets.in_frame(frame).positions_m, 80.0)
+    return tour, frame, targets
+
+
+@pytest.fixture(scope="module")
+def designed():
+    tour, frame, targets = sparse_site()
+    settings = MissionSettings(altitude_m=120.0, airspeed_m_s=22.0, design="guidance")
+    return build_mission(tour, frame, targets, settings), targets
+
+
+def test_one_waypoint_per_target_and_every_target_predicted_within_the_limit(designed):
+    mission, targets = designed
+    target_items = [i for i in mission.items if i.role == "target"]
+    assert sorted(i.target for i in target_items) == list(range(len(targets)))
+    assert len(mission.items) <= 1.4 * len(targets) + 3
+    assert max(mission.summary["predicted_miss_m"]) <= 5.0
+    assert not any("beyond --max-miss" in note for note in mission.notes)
+    # the predicted flight is about as long as the exact path over the same span
+    assert mission.summary["predicted_flight_m"] == pytest.approx(mission.summary["planned_flight_m"], rel=0.08)
+
+
+def test_the_written_mission_flown_again_passes_every_target(designed):
+    mission, targets = designed
+    flight = predict_flight(mission.for_vehicle(), Airframe.from_parameters(airspeed_m_s=22.0))
+    after = flight.track[:, 0] >= flight.reached[1]
+    xy = flight.frame.to_local(targets.latitudes_deg, targets.longitudes_deg)
+    miss = closest_approach_m(flight.track[after, 1:3], xy)
+    assert miss.max() <= 6.0, np.sort(miss)[-5:]
+
+
+def test_px4_falls_back_to_the_geometric_design_and_says_so():
+    tour, frame, targets = sparse_site(10)
+    mission = build_mission(tour, frame, targets, MissionSettings(autopilot="px4", design="guidance"))
+    assert "predicted_miss_m" not in mission.summary
+    assert any("PX4's is not modelled" in note for note in mission.notes)
+
+
+def test_a_budget_below_one_item_per_target_is_refused_with_the_count():
+    tour, frame, targets = sparse_site(30)
+    with pytest.raises(InputError, match=r"needs at least 3\d items \(one per target\)"):
+        build_mission(tour, frame, targets, MissionSettings(design="guidance", max_items=20))
