@@ -4,7 +4,7 @@ from __future__ import annotations
 
 import click
 
-from ..upload import upload_mission
+from ..upload import to_wire, upload_mission
 from ..upload.connection import read_signing_key
 from .options import (UserError, apply, link_options, mission_options, mission_settings,
                       progress_reporter, reports_errors, vehicle_options)
@@ -15,7 +15,10 @@ def run_upload(mission, connection: str, via: str, verify: bool, signing_key_fil
     """Upload with a progress bar and print what happened (shared with ``plan --upload``)."""
     key = read_signing_key(signing_key_file) if signing_key_file else None
     progress, close = progress_reporter("uploading")
-    click.echo(f"uploading {len(mission.items)} mission items to {connection} via {via}")
+    slots = len(to_wire(mission))
+    home = " and the home slot" if slots > len(mission.items) else ""
+    click.echo(f"uploading {len(mission.items)} mission items{home} ({slots} vehicle slots) to "
+               f"{connection} via {via}")
     try:
         report = upload_mission(mission, connection, via=via, verify=verify, signing_key=key,
                                 progress=progress, heartbeat_timeout_s=heartbeat_timeout_s,

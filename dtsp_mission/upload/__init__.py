@@ -12,7 +12,7 @@ from __future__ import annotations
 import time
 from dataclasses import dataclass
 
-from ..autopilot import Autopilot
+from ..autopilot import MAVLINK_MAX_ITEMS, Autopilot
 from ..autopilot.parameters import ARDUPLANE_DEFAULTS, NAMES, VehicleParameters, parameters_from
 from ..errors import InputError, LinkError
 from ..mission import VehicleMission
@@ -108,6 +108,9 @@ def upload_mission(mission: VehicleMission, connection: str, via: str = "pymavli
         raise InputError(f"the {via} uploader cannot sign MAVLink 2 messages; use --via pymavlink")
     options = {} if heartbeat_timeout_s is None else {"heartbeat_timeout_s": heartbeat_timeout_s}
     wire = to_wire(mission)
+    if len(wire) > MAVLINK_MAX_ITEMS:
+        raise InputError(f"the mission has {len(wire)} items (with the vehicle's home slot) but "
+                         f"MAVLink addresses at most {MAVLINK_MAX_ITEMS}: nothing was sent")
     started = time.perf_counter()
     with uploader_class(connection, signing_key=signing_key, **options) as uploader:
         names = NAMES if mission.autopilot == Autopilot.ARDUPILOTMEGA else ()

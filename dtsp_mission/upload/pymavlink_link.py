@@ -66,6 +66,7 @@ class PymavlinkUploader(Uploader):
             self._link.setup_signing(self.signing_key, sign_outgoing=True)
         self._last_heartbeat = 0.0
         self._bad_signatures = 0
+        self._unsigned = 0
         self._status_texts: list[str] = []
         self._wait_for_vehicle()
 
@@ -97,7 +98,11 @@ class PymavlinkUploader(Uploader):
             kind = message.get_type()
             if kind == "BAD_DATA":
                 if "signature" in str(getattr(message, "reason", "")).lower():
-                    self._bad_signatures += 1
+                    raw = bytes(getattr(message, "data", b"") or b"")
+                    if raw[:1] == b"\xfd" and len(raw) > 2 and not raw[2] & 0x01:
+                        self._unsigned += 1          # a MAVLink 2 message without signature
+                    else:
+                        self._bad_signatures += 1
                 continue
             if hasattr(self, "_target") and (message.get_srcSystem(), message.get_srcComponent()) != self._target:
                 continue
@@ -117,6 +122,10 @@ class PymavlinkUploader(Uploader):
                 raw = bytes(message.get_msgbuf())
                 self._vehicle_signs = raw[:1] == b"\xfd" and bool(raw[2] & 0x01)   # signed flag
                 return
+        if self._unsigned and not self._bad_signatures:
+            raise LinkError(f"the vehicle at {self.connection} answers, but it does not sign its "
+                            "messages: upload without --signing-key, or set up MAVLink 2 signing "
+                            "on the vehicle with this key first")
         if self._bad_signatures:
             raise LinkError(f"the vehicle at {self.connection} answers, but its messages fail the "
                             "MAVLink 2 signature check: wrong --signing-key (or the vehicle signs "

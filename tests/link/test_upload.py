@@ -81,6 +81,14 @@ def test_signing_right_key_works_wrong_key_is_named(mission, start_vehicle):
         upload_mission(mission, connection, via="mavsdk", signing_key=key)
 
 
+def test_a_key_for_a_vehicle_that_does_not_sign_says_so(mission, start_vehicle):
+    vehicle = start_vehicle(mission)                       # no signing on the vehicle
+    with pytest.raises(LinkError, match="does not sign its messages: upload without --signing-key"):
+        upload_mission(mission, f"udpout:127.0.0.1:{vehicle.port}", signing_key=bytes(range(32)),
+                       heartbeat_timeout_s=2.0)
+    assert vehicle.mission == []
+
+
 @pytest.mark.parametrize("via", UPLOADERS)
 def test_no_vehicle_is_a_clear_error_in_bounded_time(via, mission):
     started = time.monotonic()
@@ -135,3 +143,16 @@ def test_the_simulated_ardupilot_returns_what_ardupilot_stores(start_vehicle):
                               for s in sent[1:]]
     assert (downloaded[0].x, downloaded[0].y) == (round(ardupilot.home.latitude_deg * 1e7),
                                                   round(ardupilot.home.longitude_deg * 1e7))
+
+
+def test_more_items_than_mavlink_addresses_are_refused_before_anything_is_sent(mission):
+    from dataclasses import replace
+    huge = replace(mission, items=mission.items[1:2] * 65_536)
+    with pytest.raises(InputError, match="MAVLink addresses at most 65535: nothing was sent"):
+        upload_mission(huge, f"udpout:127.0.0.1:{free_udp_port()}", heartbeat_timeout_s=0.5)
+
+
+def test_a_serial_device_that_does_not_exist_is_one_clear_error():
+    with pytest.raises(LinkError, match="cannot open the connection '/dev/ttyNOSUCH0,57600'"):
+        upload_mission(make_mission(3, 1, 80.0, span_m=500.0).for_vehicle(),
+                       "/dev/ttyNOSUCH0,57600", heartbeat_timeout_s=0.5)
