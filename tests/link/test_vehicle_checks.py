@@ -61,3 +61,13 @@ def test_a_parameter_file_as_ardupilot_writes_it(tmp_path):
     parameters = read_parameters(path)
     assert parameters.NAVL1_PERIOD == 18.0 and parameters.WP_RADIUS == 60.0
     assert parameters.ROLL_LIMIT_DEG == ARDUPLANE_DEFAULTS.ROLL_LIMIT_DEG
+
+
+def test_a_px4_plan_is_refused_by_an_ardupilot_vehicle(start_vehicle):
+    px4 = make_mission(6, 5, 80.0, span_m=1000.0, autopilot="px4").for_vehicle()
+    vehicle = start_vehicle(px4, autopilot=Autopilot.ARDUPILOTMEGA)
+    with pytest.raises(LinkError) as caught:
+        upload_mission(px4, f"udpout:127.0.0.1:{vehicle.port}")
+    assert "made for PX4, but the vehicle runs ArduPilot" in str(caught.value)
+    assert "--autopilot ardupilot" in str(caught.value)
+    assert vehicle.uploads == 0
