@@ -98,6 +98,26 @@ def _nearest_in(track_xy: np.ndarray, point: np.ndarray) -> np.ndarray:
     return q[int(np.argmin(((q - point) ** 2).sum(axis=1)))]
 
 
+def _local_items(takeoff_m: np.ndarray, takeoff_alt_m: float, head_items, aim_m: np.ndarray,
+                 altitudes_m: np.ndarray, target_of: list[int],
+                 target_acceptance_m: float) -> tuple[list[LocalItem], int]:
+    """The mission the design flies (home slot, take-off, head items, the waypoints at ``aim_m``
+    relative to home, RTL), and the index of its first waypoint."""
+    items = [LocalItem(0, Command.NAV_WAYPOINT, math.nan, math.nan, 0.0, (0.0,) * 4),
+             LocalItem(1, Command.NAV_TAKEOFF, float(takeoff_m[0]), float(takeoff_m[1]),
+                       takeoff_alt_m, (15.0, 0.0, 0.0, 0.0))]
+    for command, params in head_items:
+        items.append(LocalItem(len(items), command, math.nan, math.nan, 0.0, params))
+    first = len(items)
+    for point, altitude, t in zip(aim_m, altitudes_m, target_of):
+        items.append(LocalItem(len(items), Command.NAV_WAYPOINT, float(point[0]), float(point[1]),
+                               float(altitude),
+                               (0.0, target_acceptance_m if t >= 0 else 0.0, 0.0, 0.0)))
+    items.append(LocalItem(len(items), Command.NAV_RETURN_TO_LAUNCH, math.nan, math.nan,
+                           float(altitudes_m[-1]), (0.0,) * 4))
+    return items, first
+
+
 def design_waypoints(path: FlightPath, targets_m: np.ndarray, altitudes_m: np.ndarray,
                      airframe: Airframe, max_miss_m: float, budget: int,
                      head_items: list[tuple[int, tuple[float, float, float, float]]] = (),
@@ -115,30 +135,19 @@ def design_waypoints(path: FlightPath, targets_m: np.ndarray, altitudes_m: np.nd
     s_wp = list(path.target_s_m[order])
     target_of = list(order)
     offsets = {int(t): np.zeros(2) for t in order}        # aim minus target, per target
-    best: tuple[float, np.ndarray] | None = None
+    best: tuple[float, GuidanceDesign] | None = None
     takeoff = path.chain.pose_at(np.array([0.0]))[0, :2] - home
     heading = math.atan2(takeoff[1], takeoff[0])
     stalled = {int(t): 0 for t in order}
     lookback_m = LOOKBACK_L1 * airframe.l1_distance_m(airframe.airspeed_m_s)
     previous_miss: np.ndarray | None = None
-    designed = None
     for round_number in range(1, rounds + 1):
         exact = path.chain.pose_at(np.asarray(s_wp))[:, :2]
         aim = np.array([targets_m[t] + offsets[t] if t >= 0 else exact[k]
                         for k, t in enumerate(target_of)])
-        items = [LocalItem(0, Command.NAV_WAYPOINT, math.nan, math.nan, 0.0, (0.0,) * 4),
-                 LocalItem(1, Command.NAV_TAKEOFF, takeoff[0], takeoff[1],
-                           float(path.altitude_m(np.array([0.0]))[0]), (15.0, 0.0, 0.0, 0.0))]
-        for command, params in head_items:
-            items.append(LocalItem(len(items), command, math.nan, math.nan, 0.0, params))
-        first = len(items)
-        altitude = path.altitude_m(np.asarray(s_wp))
-        for k, (point, t) in enumerate(zip(aim - home, target_of)):
-            items.append(LocalItem(len(items), Command.NAV_WAYPOINT, float(point[0]), float(point[1]),
-                                   float(altitude[k]),
-                                   (0.0, target_acceptance_m if t >= 0 else 0.0, 0.0, 0.0)))
-        items.append(LocalItem(len(items), Command.NAV_RETURN_TO_LAUNCH, math.nan, math.nan,
-                               float(altitude[-1]), (0.0,) * 4))
+        items, first = _local_items(takeoff, float(path.altitude_m(np.array([0.0]))[0]),
+                                    head_items, aim - home, path.altitude_m(np.asarray(s_wp)),
+                                    target_of, target_acceptance_m)
         track, reached = _fly(items, airframe, heading, len(items) - 2)
         flown = track[:, 1:] + home
         after_takeoff = track[:, 0] >= reached.get(1, 0.0)
