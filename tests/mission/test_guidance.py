@@ -64,3 +64,11 @@ def test_a_budget_below_one_item_per_target_is_refused_with_the_count():
     tour, frame, targets = sparse_site(30)
     with pytest.raises(InputError, match=r"needs at least 3\d items \(one per target\)"):
         build_mission(tour, frame, targets, MissionSettings(design="guidance", max_items=20))
+
+
+def test_the_same_input_gives_the_same_mission(designed):
+    mission, _ = designed
+    tour, frame, targets = sparse_site()
+    again = build_mission(tour, frame, targets, MissionSettings(altitude_m=120.0, airspeed_m_s=22.0,
+                                                                 design="guidance"))
+    assert again.items == mission.items
