@@ -52,6 +52,12 @@ ARDUPLANE_DEFAULTS = VehicleParameters()
 NAMES = tuple(f.name for f in fields(VehicleParameters))
 
 
+def parameter_name(param_id: str | bytes) -> str:
+    """A PARAM_* message's ``param_id`` as text (pymavlink gives str or bytes, NUL-padded)."""
+    text = param_id.decode("ascii", "replace") if isinstance(param_id, bytes) else param_id
+    return text.rstrip("\0")
+
+
 def parse_parameters(text: str, where: str = "parameters") -> dict[str, float]:
     """Every ``NAME VALUE`` of a parameter file's text, by name."""
     values: dict[str, float] = {}

@@ -140,18 +140,11 @@ _PX4_FRAMES = {Frame.GLOBAL_INT: Frame.GLOBAL, Frame.GLOBAL_RELATIVE_ALT_INT: Fr
                Frame.GLOBAL_TERRAIN_ALT_INT: Frame.GLOBAL_TERRAIN_ALT}
 
 
-def _px4(item: WireItem) -> WireItem:
-    return WireItem.normalised(item.seq, item.frame, item.command, item.current, item.autocontinue,
-                               item.param1, item.param2, item.param3, item.param4, item.x,
-                               item.y, item.z, item.mission_type)
-
-
 def stored_item(item: WireItem, autopilot: Autopilot) -> WireItem:
     """What ``autopilot`` returns on download for ``item`` sent to it (``seq`` and
     ``current`` unchanged)."""
-    if autopilot == Autopilot.ARDUPILOTMEGA:
-        return _ardupilot(WireItem.normalised(**item.__dict__))
-    return _px4(item)
+    item = WireItem.normalised(**item.__dict__)       # PX4 keeps what the wire carries
+    return _ardupilot(item) if autopilot == Autopilot.ARDUPILOTMEGA else item
 
 
 def comparable(item: WireItem, autopilot: Autopilot, sent: bool = True) -> WireItem:

@@ -152,10 +152,9 @@ def _design_for_guidance(path: FlightPath, tour: Tour, frame: LocalFrame, target
             "split the targets into several missions")
     head = ([(Command.DO_CHANGE_SPEED, (0.0, float(settings.airspeed_m_s), -1.0, 0.0))]
             if settings.airspeed_m_s is not None else [])
-    local = frame.to_local(targets.latitudes_deg, targets.longitudes_deg)
-    altitudes = (np.full(len(local), settings.altitude_m) if targets.altitudes_m is None
+    altitudes = (np.full(len(tour.targets_m), settings.altitude_m) if targets.altitudes_m is None
                  else np.asarray(targets.altitudes_m, dtype=float))
-    design = design_waypoints(path, local, altitudes, airframe, settings.max_miss_m, budget, head,
+    design = design_waypoints(path, tour.targets_m, altitudes, airframe, settings.max_miss_m, budget, head,
                               settings.target_acceptance_m)
     return replace(design, s_m=np.concatenate([[0.0], design.s_m, tail]),
                    aim_m=np.vstack([path.chain.pose_at(np.array([0.0]))[:, :2], design.aim_m,
@@ -251,10 +250,7 @@ def _items(path: FlightPath, chosen: np.ndarray, frame: LocalFrame, targets: Geo
     if design is None:
         target_at = {float(s): index for index, s in enumerate(path.target_s_m)}
     else:
-        target_at = {}
-        for k, t in enumerate(design.target_of):
-            if t >= 0:
-                target_at[k] = int(t)
+        target_at = {k: int(t) for k, t in enumerate(design.target_of) if t >= 0}
     items = [MissionItem(Command.NAV_TAKEOFF, Frame.GLOBAL_RELATIVE_ALT,
                          (float(settings.takeoff_pitch_deg), 0.0, 0.0, 0.0), float(latitudes[0]),
                          float(longitudes[0]), float(settings.altitude_m), True, "takeoff")]

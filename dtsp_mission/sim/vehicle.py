@@ -1,5 +1,7 @@
-"""A simulated fixed-wing vehicle that speaks MAVLink: MAVSDK's server plugins serve the
-mission protocol and telemetry, :class:`~dtsp_mission.autopilot.navigation.MissionFlight` flies.
+"""A simulated fixed-wing vehicle that speaks MAVLink: MAVSDK's server plugins take uploads and
+serve telemetry, the vehicle's own code serves downloads from what it stored (as the autopilot
+stores items, :mod:`dtsp_mission.autopilot.storage`), and
+:class:`~dtsp_mission.autopilot.navigation.MissionFlight` flies.
 
 MAVSDK runs on a ``raw://`` connection; this module owns the UDP socket and sits between it
 and the ground station, adding what the server plugins do not do: a heartbeat as a fixed
@@ -20,13 +22,13 @@ import numpy as np
 from pymavlink.dialects.v20 import common as mavlink2
 
 from ..autopilot.navigation import Airframe, LocalItem, MissionFlight, local_items
-from ..autopilot.parameters import ARDUPLANE_DEFAULTS, NAMES, VehicleParameters
+from ..autopilot.parameters import ARDUPLANE_DEFAULTS, NAMES, VehicleParameters, parameter_name
 from ..autopilot.storage import capacity, stored_item
 from ..frame import LocalFrame
 from ..mavsdk_log import quiet_mavsdk_log
-from ..mission import Autopilot, Frame
-from ..mission.model import Home
-from ..upload.wire import WireItem, first_mission_seq
+from ..mission import Autopilot
+from ..mission.model import Home, degrees_to_e7
+from ..upload.wire import WireItem, first_mission_seq, home_placeholder
 from ..vehicle import heading_to_bearing_deg
 
 MAV_TYPE_FIXED_WING = 1
@@ -291,7 +293,7 @@ class SimulatedVehicle:
                 self._encoder.command_ack_send(MAV_CMD_REQUEST_MESSAGE, MAV_RESULT_ACCEPTED, 0, 0,
                                                message.get_srcSystem(), message.get_srcComponent())
                 self._encoder.home_position_send(
-                    round(home.latitude_deg * 1e7), round(home.longitude_deg * 1e7),
+                    degrees_to_e7(home.latitude_deg), degrees_to_e7(home.longitude_deg),
                     round(home.altitude_amsl_m * 1000), 0.0, 0.0, 0.0, [1.0, 0.0, 0.0, 0.0],
                     0.0, 0.0, 0.0)
             return True
@@ -310,8 +312,7 @@ class SimulatedVehicle:
         like a real vehicle it stays silent for a name it does not know."""
         if self.settings.autopilot != Autopilot.ARDUPILOTMEGA:
             return
-        name = message.param_id.rstrip("\0") if isinstance(message.param_id, str) \
-            else message.param_id.decode().rstrip("\0")
+        name = parameter_name(message.param_id)
         if message.param_index >= 0 and not name:
             name = NAMES[message.param_index] if message.param_index < len(NAMES) else ""
         if name not in NAMES:
@@ -351,11 +352,7 @@ class SimulatedVehicle:
         """ArduPilot keeps its own home at seq 0, whatever was sent there."""
         if not items or first_mission_seq(self.settings.autopilot) == 0:
             return items
-        home = self.settings.home
-        own = WireItem.normalised(0, Frame.GLOBAL, 16, 0, 1, 0, 0, 0, 0,
-                                  round(home.latitude_deg * 1e7), round(home.longitude_deg * 1e7),
-                                  home.altitude_amsl_m)
-        return [own] + items[1:]
+        return [home_placeholder(self.settings.home)] + items[1:]
 
     def _set_mission(self, items: list[WireItem]) -> None:
         self.mission = items

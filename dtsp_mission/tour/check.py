@@ -135,14 +135,15 @@ def check_path(chain: SegmentChain, rho_m: float, targets_m: np.ndarray, visit_s
             problems.append(f"{int(missed.sum())} targets are not on the path (first: target "
                             f"{first}, missed by {misses[first]:.3g} m)")
     if len(chain) and finite and np.isfinite(rho):
-        problems.extend(_invariant_problems(chain, rho, tolerance_m, visits if len(targets_m) else
-                                            np.zeros(0), closed, max_heading * len(chain)))
+        problems.extend(_invariant_problems(chain, rho, tolerance_m, tolerance_rho,
+                                            visits if len(targets_m) else np.zeros(0), closed,
+                                            max_heading * len(chain)))
     return CheckReport(tuple(problems), len(chain), len(targets_m), chain.length_m,
                        max_gap, max_heading, max_curvature_ratio, max_miss)
 
 
-def _invariant_problems(chain: SegmentChain, rho: float, tolerance_m: float, visits: np.ndarray,
-                        closed: bool, heading_slack_rad: float) -> list[str]:
+def _invariant_problems(chain: SegmentChain, rho: float, tolerance_m: float, tolerance_rad: float,
+                        visits: np.ndarray, closed: bool, heading_slack_rad: float) -> list[str]:
     """Violations of the invariants that hold for every feasible path (module docstring)."""
     problems = []
     length = chain.length_m
@@ -153,7 +154,7 @@ def _invariant_problems(chain: SegmentChain, rho: float, tolerance_m: float, vis
         turning = float(np.sum(chain.curvatures_1_m * chain.lengths_m))
         turns = turning / (2.0 * np.pi)
         off = abs(turns - round(turns)) * 2.0 * np.pi
-        if off > max(TOLERANCE_RHO, heading_slack_rad) + 1e-12 * len(chain):
+        if off > max(tolerance_rad, heading_slack_rad) + 1e-12 * len(chain):
             problems.append(f"the total turning is {turns:.9f} turns, not a whole number")
     usable = np.isfinite(visits) & (visits >= 0) & (visits <= length + tolerance_m)
     s = np.sort(np.clip(visits[usable], 0.0, length))

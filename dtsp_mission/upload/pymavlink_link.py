@@ -14,6 +14,7 @@ import time
 
 from pymavlink import mavutil
 
+from ..autopilot.parameters import parameter_name
 from ..errors import LinkError
 from ..mission import Command
 from .connection import check_host
@@ -162,8 +163,7 @@ class PymavlinkUploader(Uploader):
             while (remaining := deadline - time.monotonic()) > 0 and len(values) < len(parameter_names):
                 message = self._receive({"PARAM_VALUE"}, remaining)
                 if message is not None:
-                    name = message.param_id.rstrip("\0") if isinstance(message.param_id, str) \
-                        else message.param_id.decode().rstrip("\0")
+                    name = parameter_name(message.param_id)
                     if name in parameter_names:
                         values[name] = float(message.param_value)
         home = None
