@@ -57,7 +57,9 @@ def test_headings_planner_on_degenerate_inputs(points, rho):
 
 
 def test_auto_considers_the_headings_planner():
-    tour = get_planner("auto").plan(uniform(300, 1), 100.0)
+    tour = get_planner("auto", time_limit_s=0).plan(uniform(300, 1), 100.0)
     candidates = tour.report["candidates"]
-    assert {"alternating", "headings", "rbta"} <= set(candidates)
-    assert tour.length_m == min(v for v in candidates.values() if isinstance(v, float))
+    assert {"alternating", "headings", "rbta", "lanes", "nearest"} <= set(candidates)
+    # With no improvement budget the best peer's tour is rebuilt from its poses with shortest
+    # Dubins legs, never longer.
+    assert tour.length_m <= min(v for v in candidates.values() if isinstance(v, float)) + 1e-6

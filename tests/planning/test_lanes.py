@@ -110,10 +110,10 @@ def test_lanes_beat_the_euclidean_order_at_five_thousand_targets():
 
 
 def test_auto_returns_the_shortest_of_its_candidates_including_lanes():
-    tour = get_planner("auto").plan(uniform(1500, 2), 100.0)
+    tour = get_planner("auto", time_limit_s=0.5).plan(uniform(1500, 2), 100.0)
     candidates = tour.report["candidates"]
-    assert {"alternating", "headings", "lanes", "rbta"} <= set(candidates)
-    assert tour.length_m == pytest.approx(min(v for v in candidates.values() if isinstance(v, float)))
+    assert {"alternating", "headings", "lanes", "rbta", "nearest"} <= set(candidates)
+    assert tour.length_m <= min(v for v in candidates.values() if isinstance(v, float)) + 1e-6
 
 
 def test_nearest_neighbour_visits_every_target_once():
