@@ -8,7 +8,7 @@ import sys
 def test_planner_bench_measures_every_planner_and_auto_is_shortest(tmp_path):
     result = subprocess.run(
         [sys.executable, "-m", "dtsp_mission.cli", "bench", "planners", "--sizes", "40,300",
-         "--seeds", "2", "--json", str(tmp_path / "runs.json"), "--csv", str(tmp_path / "runs.csv"),
+         "--seeds", "2", "--time-limit", "1", "--json", str(tmp_path / "runs.json"), "--csv", str(tmp_path / "runs.csv"),
          "--markdown", str(tmp_path / "table.md"), "--plot", str(tmp_path / "plot.png")],
         capture_output=True, text=True, timeout=600)
     assert result.returncode == 0, result.stderr
@@ -30,3 +30,31 @@ def test_planner_bench_measures_every_planner_and_auto_is_shortest(tmp_path):
     assert "Produced by `dtsp-mission bench planners" in (tmp_path / "table.md").read_text()
     assert (tmp_path / "runs.csv").read_text().count("\n") == len(runs) + 1
     assert (tmp_path / "plot.png").read_bytes()[:4] == b"\x89PNG"
+
+
+def test_the_anchor_is_a_peer_on_every_family_and_the_table_gives_each_length_over_it(tmp_path):
+    result = subprocess.run(
+        [sys.executable, "-m", "dtsp_mission.cli", "bench", "planners", "--sizes", "12",
+         "--seeds", "1", "--families", "uniform,dense,clustered", "--planners", "auto,headings",
+         "--anchor", "--time-limit", "1", "--json", str(tmp_path / "runs.json"),
+         "--markdown", str(tmp_path / "table.md")],
+        capture_output=True, text=True, timeout=600)
+    assert result.returncode == 0, result.stderr
+    runs = json.loads((tmp_path / "runs.json").read_text())
+    assert {(r["family"], r["planner"]) for r in runs} == {
+        (f, p) for f in ("uniform", "dense", "clustered") for p in ("auto", "headings", "lkh-anchor")}
+    for r in runs:
+        assert r["valid"], r
+        assert r["over_anchor"] == r["length_m"] / r["anchor_m"]
+        if r["planner"] == "auto":      # at or below the anchor (K = 8, 16, 32) on 12 targets,
+            assert r["length_m"] <= r["anchor_m"] * (1 + 1e-6)   # to 1 mm per km
+    assert "/ anchor (median, range)" in result.stdout
+    table = (tmp_path / "table.md").read_text()
+    assert "| dense | 12 | lkh-anchor |" in table
+    # The table can be made again from the runs, measuring nothing.
+    merged = subprocess.run(
+        [sys.executable, "-m", "dtsp_mission.cli", "bench", "planners", "--merge",
+         str(tmp_path / "runs.json"), "--markdown", str(tmp_path / "again.md")],
+        capture_output=True, text=True, timeout=600)
+    assert merged.returncode == 0, merged.stderr
+    assert (tmp_path / "again.md").read_text().split("\n\n", 2)[2] == table.split("\n\n", 2)[2]

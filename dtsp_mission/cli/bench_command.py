@@ -55,6 +55,18 @@ def _sizes(ctx, param, value: str) -> list[int]:
               help="Side of the square the targets are uniform in, metres.")
 @click.option("--planners", "names", default=None,
               help="Planners to compare, comma separated (default: every installed one).")
+@click.option("--families", default="uniform", show_default=True,
+              help="Instance families, comma separated: uniform, dense (1.5 km square), "
+                   "clustered (Gaussian clusters among sparse targets), site (the bundled "
+                   "inspection site, at rho 80 m).")
+@click.option("--anchor", is_flag=True,
+              help="Add the LKH-3 GTSP anchor (K = 8, 16, 32 headings, Noon-Bean, elkai) as a "
+                   "peer and give every length over it; needs pip install -e \".[bench]\".")
+@click.option("--time-limit", "time_limit_s", type=click.FloatRange(min=0.0), default=None,
+              help="auto's improvement budget in reference seconds (default: auto's own).")
+@click.option("--merge", "merge_files", multiple=True, type=click.Path(exists=True, dir_okay=False),
+              help="Measure nothing: tabulate the runs of earlier --json outputs (repeatable; "
+                   "e.g. families measured on separate cores).")
 @click.option("--csv", "csv_file", type=click.Path(dir_okay=False), help="Write every run as CSV.")
 @click.option("--json", "json_file", type=click.Path(dir_okay=False), help="Write every run as JSON.")
 @click.option("--markdown", "markdown_file", type=click.Path(dir_okay=False),
@@ -62,10 +74,11 @@ def _sizes(ctx, param, value: str) -> list[int]:
 @click.option("--plot", "plot_file", type=click.Path(dir_okay=False),
               help="Log-log PNG of length against n, with the lower bound.")
 @reports_errors
-def planners_bench(sizes, seeds, rho_m, side_m, names, csv_file, json_file, markdown_file,
-                   plot_file) -> None:
-    """Every planner on seeded uniform instances: length, ratio to the lower bound and to the
-    best of the run, time, peak memory, checker verdict (medians over seeds)."""
+def planners_bench(sizes, seeds, rho_m, side_m, names, families, anchor, time_limit_s, merge_files,
+                   csv_file, json_file, markdown_file, plot_file) -> None:
+    """Every planner on seeded instances of each family: length, ratio to the lower bound, to
+    the best of the run and (--anchor) to the LKH-3 anchor, time, peak memory, checker
+    verdict (medians over seeds)."""
     import sys
 
     from ..bench import planners as planner_bench
@@ -80,19 +93,34 @@ def planners_bench(sizes, seeds, rho_m, side_m, names, csv_file, json_file, mark
     unknown = sorted(set(chosen) - set(installed))
     if unknown:
         raise UserError(f"unknown planner(s) {', '.join(unknown)} (installed: {', '.join(installed)})")
-    steps = len(sizes) * seeds * len(chosen)
-    with click.progressbar(length=steps, label="planning", file=sys.stderr,
-                           item_show_func=lambda step: step) as bar:
-        def progress(step: str) -> None:
-            bar.update(1, step)
-        runs = planner_bench.run(sizes, seeds, rho_m, side_m, chosen, progress)
-    click.echo(f"uniform targets in a {side_m:g} m square, rho {rho_m:g} m, {seeds} seeds; "
-               "medians over seeds")
+    from ..bench.instances import FAMILIES
+    family_list = [f.strip() for f in families.split(",") if f.strip()]
+    if not family_list or set(family_list) - set(FAMILIES):
+        raise UserError(f"--families takes a comma-separated list of {', '.join(FAMILIES)}")
+    if anchor:
+        from ..bench.anchor import AnchorPlanner, require_elkai
+        require_elkai()
+        chosen.append(AnchorPlanner.name)
+    steps = sum(1 if f == "site" else len(sizes) * seeds for f in family_list) * len(chosen)
+    if merge_files:
+        runs = [run for path in merge_files for run in planner_bench.from_json(path)]
+        family_list = list(dict.fromkeys(r.family for r in runs))
+        seeds = len({r.seed for r in runs})
+    else:
+        with click.progressbar(length=steps, label="planning", file=sys.stderr,
+                               item_show_func=lambda step: step) as bar:
+            def progress(step: str) -> None:
+                bar.update(1, step)
+            runs = planner_bench.run(sizes, seeds, rho_m, side_m, chosen, progress, family_list,
+                                     time_limit_s)
+    click.echo(f"families {', '.join(family_list)} (uniform and clustered in a {side_m:g} m "
+               f"square), rho {rho_m:g} m, {seeds} seeds; medians over seeds")
     click.echo(planner_bench.table(runs))
     for r in runs:
         if not r.valid:
             verdict = "not applicable" if r.not_applicable else "FAILED"
-            click.echo(f"{verdict}: n={r.n} seed={r.seed} {r.planner}: {r.error or 'checker'}")
+            click.echo(f"{verdict}: {r.family} n={r.n} seed={r.seed} {r.planner}: "
+                       f"{r.error or 'checker'}")
     command = "dtsp-mission bench planners " + " ".join(sys.argv[3:]) if len(sys.argv) > 3 else \
         "dtsp-mission bench planners"
     for path, content in ((csv_file, lambda: planner_bench.as_csv(runs)),
