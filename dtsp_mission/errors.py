@@ -17,6 +17,15 @@ class InputError(DtspError, ValueError):
     """The user's input (targets, radius, options) cannot be planned as given."""
 
 
+class MissionTooLarge(InputError):
+    """The mission needs more items than the vehicle holds (``--max-items``): ``needed``
+    items (at least) against ``capacity``."""
+
+    def __init__(self, message: str, needed: int = 0, capacity: int = 0) -> None:
+        super().__init__(message)
+        self.needed, self.capacity = needed, capacity
+
+
 class FileFormatError(DtspError, ValueError):
     """A file could be read but its content is not what its format requires."""
 

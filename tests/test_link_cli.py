@@ -14,6 +14,7 @@ from click.testing import CliRunner
 
 from conftest import free_udp_port, make_mission
 from dtsp_mission.autopilot import Autopilot
+from dtsp_mission.autopilot.navigation import Airframe
 from dtsp_mission.cli.main import cli
 from dtsp_mission.export import exporter_for
 from dtsp_mission.upload.wire import differences, to_wire
@@ -125,3 +126,31 @@ def test_upload_a_tour_json_builds_the_mission_with_plan_options(tmp_path, start
     assert run("plan", tmp_path / "local.csv", "--radius", 80, "-o", bare).exit_code == 0
     result = run("upload", bare, "--connect", f"udpout:127.0.0.1:{vehicle.port}")
     assert result.exit_code == 2 and "no frame origin" in result.output
+
+
+def test_a_site_too_big_for_the_vehicle_is_flown_as_sorties_it_accepts(tmp_path, start_vehicle):
+    """The whole site does not fit a vehicle holding 120 items; plan splits it, the simulated
+    vehicle with that real capacity accepts each sortie, and each sortie flies its targets."""
+    capacity = 120
+    out = tmp_path / "site.plan"
+    result = run("plan", SITE, "--radius", 80, "--alt", 120, "--airspeed", 22, "--home",
+                 "46.8155,6.9618", "--max-items", capacity, "-o", out, "--time-limit", 2)
+    assert result.exit_code == 0, result.output
+    count = int(re.search(r"split into (\d+) sorties", result.output).group(1))
+    files = [tmp_path / f"site-{k}.plan" for k in range(1, count + 1)]
+    assert all(f.exists() for f in files) and not out.exists()
+    missions = [exporter_for(f).read(f) for f in files]
+    vehicle = start_vehicle(missions[0], max_items=capacity, airframe=Airframe(22.0, 80.0))
+    flown = 0
+    for path, sortie in zip(files, missions):
+        assert len(sortie.items) + 1 <= capacity
+        result = run("upload", path, "--connect", f"udpout:127.0.0.1:{vehicle.port}")
+        assert result.exit_code == 0, result.output
+        assert "holds exactly the planned mission" in result.output
+        assert len(vehicle.mission) == len(sortie.items) + 1
+        result = run("fly", path, "--radius", 80, "--airspeed", 22, "--speedup", 1000,
+                     "--max-miss", 1000)
+        assert result.exit_code == 0, result.output
+        assert "simulated flight completed" in result.output
+        flown += len(re.findall(r"^item \d+\t([\d.]+)\t", result.output, re.M))
+    assert flown == 272                     # every target in exactly one sortie, each flown

@@ -51,11 +51,25 @@ def test_site_example_to_every_format_and_a_plot(tmp_path):
     assert {t["altitude_m"] for t in targets} == {90.0, 70.0, 60.0}
 
 
-def test_geometry_design_over_the_stock_budget_refuses_with_the_count_and_a_coarser_tolerance_fits(tmp_path):
-    result = run(SITE, "--radius", "80", "--design", "geometry", "-o", tmp_path / "m.plan")
-    assert result.returncode == 2 and "items at a waypoint tolerance" in result.stderr
-    assert "holds 655" in result.stderr
-    assert not (tmp_path / "m.plan").exists()
+def test_geometry_design_over_the_stock_budget_is_split_into_sorties_and_a_coarser_tolerance_fits(tmp_path):
+    result = run(SITE, "--radius", "80", "--design", "geometry", "--airspeed", "22",
+                 "--max-items", "300", "-o", tmp_path / "m.plan", "-o", tmp_path / "tour.json")
+    assert result.returncode == 0, result.stderr
+    assert re.search(r"as one mission it needs \d+ items \(at least\) but the vehicle holds 300", result.stdout)
+    count = int(re.search(r"split into (\d+) sorties", result.stdout).group(1))
+    assert count >= 2 and not (tmp_path / "m.plan").exists()
+    targets = 0
+    for k in range(1, count + 1):
+        assert f"sortie {k}:" in result.stdout
+        items = json.loads((tmp_path / f"m-{k}.plan").read_text())["mission"]["items"]
+        assert len(items) + 1 <= 300
+        assert items[0]["command"] == 22 and items[-1]["command"] == 20     # take-off ... RTL
+        targets += sum(i["command"] == 16 and i["params"][1] > 0 for i in items)
+    assert targets == 272                    # every target in exactly one sortie
+    assert not (tmp_path / f"m-{count + 1}.plan").exists()
+    # The tour file is the whole tour, placed on the earth.
+    tour = json.loads((tmp_path / "tour.json").read_text())
+    assert "origin" in json.dumps(tour)
     result = run(SITE, "--radius", "80", "--design", "geometry", "--tolerance", "8", "-o",
                  tmp_path / "m.plan")
     assert result.returncode == 0, result.stderr
@@ -120,3 +134,12 @@ def test_vehicle_options_must_be_complete(tmp_path):
     assert result.returncode == 2 and "give the turn radius" in result.stderr
     result = run(SITE, "--radius", "80", "--airspeed", "20", "--max-bank", "30")
     assert result.returncode == 2 and "not both" in result.stderr
+
+
+def test_a_tour_only_output_never_fails_on_the_mission_budget(tmp_path):
+    out = tmp_path / "tour.json"
+    result = run(SITE, "--radius", "80", "--max-items", "50", "-o", out)
+    assert result.returncode == 0, result.stderr
+    assert "as one mission this would not fit the vehicle" in result.stderr
+    tour = json.loads(out.read_text())
+    assert "origin" in json.dumps(tour) and len(tour["targets"]) == 272

@@ -11,20 +11,22 @@ import numpy as np
 import shapely
 
 from ..api import local_frame_for
+from ..errors import MissionTooLarge
 from ..export import exporter_for
+from ..files import write_atomic
 from ..frame import LocalFrame
-from ..mission import Autopilot, build_mission
-from ..planning import TilingUnavailable, get_planner, planners
+from ..mission import Autopilot, Mission, build_mission
 from ..mission.build import targets_beyond, with_turn_margin
+from ..mission.sorties import sortie_path, split_into_sorties
+from ..planning import TilingUnavailable, get_planner, planners
 from ..planning.base import MERGE_RESOLUTION_RHO
 from ..planning.lower_bounds import lower_bound
-from ..files import write_atomic
 from ..planning.rbta import region_heading_deg
 from ..plot import draw_plan, plot_format, require_matplotlib
 from ..targets import GeoTargets, Targets, random_targets, read_targets
 from ..targets.geojson_file import read_geojson
 from .options import (LAT_LON, UserError, apply, link_options, mission_options,
-                      mission_settings, reports_errors, seed_option, simulation_options,
+                      mission_settings, progress_reporter, reports_errors, seed_option, simulation_options,
                       turn_radius_from, vehicle_options)
 
 
@@ -112,6 +114,12 @@ def _duration(seconds: float) -> str:
 @click.option("--region", default="bounding", show_default=True,
               help="Rectangle the bead tiling covers: 'bounding', 'min-area', or a sweep "
                    "heading in degrees counter-clockwise from east.")
+@click.option("--time-limit", "time_limit_s", type=click.FloatRange(min=0.0), default=None,
+              metavar="SECONDS",
+              help="Work budget of auto's improvement stage, in seconds of the reference machine "
+                   "(a fixed amount of work: the same input, limit and --seed give the same tour "
+                   "everywhere). Default 10 s up to 2,000 targets, 2.5 ms more per target "
+                   "above, at most 60 s; 0 keeps the best peer's tour.")
 @click.option("--fallback/--no-fallback", default=True, show_default=True,
               help="If the RBTA cannot tile (too few targets), plan with the Alternating "
                    "Algorithm instead of failing.")
@@ -131,7 +139,8 @@ def _duration(seconds: float) -> str:
 @reports_errors
 def plan(targets_file, random_count, area_file, seed, origin, rho_m, airspeed_m_s, max_bank_deg,
          altitude_m, home_deg, home_amsl_m, launch_bearing_deg, landing_bearing_deg, autopilot,
-         return_mode, design, max_miss_m, tolerance_m, max_items, algorithm, region, fallback, outputs, format_name,
+         return_mode, design, max_miss_m, tolerance_m, max_items, algorithm, region, time_limit_s,
+         fallback, outputs, format_name,
          plot_file, connection, via, verify, signing_key_file, simulate, speedup, vehicle_params_file,
          l1_period_s) -> None:
     """Plan a Dubins tour through the targets and write it as a mission.
@@ -171,25 +180,41 @@ def plan(targets_file, random_count, area_file, seed, origin, rho_m, airspeed_m_
     click.echo(f"{len(local)} targets; {rho_source}")
 
     parameters = {"region": region} if algorithm in ("rbta", "auto") else {}
+    if algorithm == "auto":
+        parameters.update(time_limit_s=time_limit_s, seed=seed)
     started = time.perf_counter()
+    progress, close_progress = progress_reporter("improving the tour")
     try:
-        tour = get_planner(algorithm, **parameters).plan(local.positions_m, rho)
+        planner = get_planner(algorithm, **parameters)
+        if algorithm == "auto":
+            planner.progress = lambda fraction: progress(int(1000 * fraction), 1000)
+        tour = planner.plan(local.positions_m, rho)
     except TilingUnavailable as error:
         if not fallback:
             raise
         click.echo(f"note: {error}; planning with the Alternating Algorithm instead", err=True)
         tour = get_planner("alternating").plan(local.positions_m, rho)
+    finally:
+        close_progress()
     elapsed = time.perf_counter() - started
     _report_tour(tour, local.positions_m, area_m, elapsed)
 
     product = tour
+    sorties = []
     if frame is not None:
         settings = mission_settings(autopilot, altitude_m, airspeed_m_s, home_deg, home_amsl_m,
                                     launch_bearing_deg, landing_bearing_deg, return_mode, design,
                                     max_miss_m, tolerance_m, max_items,
                                     _designed_for(vehicle_params_file))
-        product = build_mission(tour, frame, geodetic, settings)
-        if "predicted_miss_m" in product.summary:
+        try:
+            product = build_mission(tour, frame, geodetic, settings)
+        except MissionTooLarge as error:
+            if not (any(writer.needs_mission for _, writer in writers) or connection or simulate):
+                # Only the tour is asked for: the vehicle's storage does not limit it.
+                click.echo(f"note: as one mission this would not fit the vehicle: {error}", err=True)
+            else:
+                sorties = _split(tour, frame, geodetic, settings, error)
+        if isinstance(product, Mission) and "predicted_miss_m" in product.summary:
             planner = get_planner(algorithm, **parameters)
             widened = with_turn_margin(product, lambda r: planner.plan(local.positions_m, r),
                                        geodetic, settings)
@@ -200,12 +225,23 @@ def plan(targets_file, random_count, area_file, seed, origin, rho_m, airspeed_m_
                            f"{targets_beyond(widened, max_miss_m)} targets predicted beyond "
                            "--max-miss", err=True)
                 product, tour = widened, widened.tour
-        _report_mission(product)
+        if isinstance(product, Mission):
+            _report_mission(product)
     elif airspeed_m_s:
         click.echo(f"flight time of the tour at {airspeed_m_s:g} m/s: "
                    f"{_duration(tour.length_m / airspeed_m_s)}")
+    if sorties and connection:
+        raise UserError(f"the mission is split into {len(sorties)} sorties (one file each); "
+                        "upload them one at a time with `dtsp-mission upload FILE`")
     # All or nothing: every file is rendered before the first is written.
-    rendered = [(output, writer, writer.render_for(product, output)) for output, writer in writers]
+    rendered = []
+    for output, writer in writers:
+        if sorties and writer.needs_mission:
+            rendered += [(sortie_path(output, k + 1), writer,
+                          writer.render_for(sortie.mission, sortie_path(output, k + 1)))
+                         for k, sortie in enumerate(sorties)]
+        else:
+            rendered.append((output, writer, writer.render_for(product, output, frame)))
     for output, writer, content in rendered:
         write_atomic(output, content)
         click.echo(f"wrote {output} ({writer.description})")
@@ -220,13 +256,39 @@ def plan(targets_file, random_count, area_file, seed, origin, rho_m, airspeed_m_
         from .fly_command import run_flight_check
         from .sim_command import airframe_from
         airframe, _, _ = airframe_from(vehicle_params_file, airspeed_m_s, None, l1_period_s)
-        mission = product.for_vehicle()
-        run_flight_check(mission, planned_targets(product), airframe, via, speedup, max_miss_m,
-                         max_items)
+        for k, flown in enumerate([s.mission for s in sorties] or [product]):
+            if sorties:
+                click.echo(f"sortie {k + 1} of {len(sorties)}:")
+            run_flight_check(flown.for_vehicle(), planned_targets(flown), airframe, via, speedup,
+                             max_miss_m, max_items)
     if connection:
         from .upload_command import run_upload
         run_upload(product.for_vehicle(), connection, via, verify, signing_key_file,
                    designed_for=_designed_for(vehicle_params_file))
+
+
+def _split(tour, frame, geodetic, settings, error):
+    """The sorties of a mission too large for the vehicle, printed."""
+    home_m = (frame.to_local(*settings.home_deg)[0] if settings.home_deg is not None
+              else np.zeros(2))
+    sorties = split_into_sorties(tour, frame, geodetic, settings, home_m)
+    click.echo(f"as one mission it needs {error.needed} items (at least) but the vehicle holds "
+               f"{error.capacity} (--max-items): split into {len(sorties)} sorties, each a "
+               "take-off, a contiguous part of the tour and the return, balanced by flight time:")
+    names = geodetic.names
+    for k, sortie in enumerate(sorties):
+        summary = sortie.mission.summary
+        first, last = sortie.targets[0], sortie.targets[-1]
+        label = (lambda i: names[i] if names else f"target {i + 1}")
+        time_text = (f", {_duration(summary['flight_time_s'])}" if "flight_time_s" in summary
+                     else "")
+        beyond = targets_beyond(sortie.mission, settings.max_miss_m) \
+            if "predicted_miss_m" in summary else 0
+        click.echo(f"  sortie {k + 1}: {len(sortie.targets)} targets ({label(first)} .. "
+                   f"{label(last)}), {summary['items']} items, "
+                   f"{summary['flight_length_m'] / 1e3:,.2f} km{time_text}"
+                   + (f", {beyond} predicted beyond --max-miss" if beyond else ""))
+    return sorties
 
 
 def _designed_for(vehicle_params_file):
@@ -257,6 +319,14 @@ def _report_tour(tour, positions: np.ndarray, area_m: np.ndarray | None, elapsed
     for name, result in tour.report.get("candidates", {}).items():
         shown = f"{result:,.1f} m" if isinstance(result, float) else result
         click.echo(f"  candidate {name}: {shown}")
+    improvement = tour.report.get("improvement")
+    if improvement:
+        gain = 1.0 - improvement["length_m"] / improvement["start_m"]
+        spent = improvement["evaluations"] / max(improvement["budget"], 1)
+        click.echo(f"  improvement: {improvement['start_m']:,.1f} m -> {improvement['length_m']:,.1f} m "
+                   f"({100 * gain:.1f} % shorter; {improvement['kicks']} perturbations, "
+                   f"{100 * min(spent, 1.0):.0f} % of the --time-limit budget, "
+                   f"{'stopped by the budget' if improvement['stopped'] == 'budget' else improvement['stopped']})")
     if "leftovers" in tour.report:
         click.echo(f"  leftovers (Alternating Algorithm): {tour.report['leftovers']} targets, "
                    f"{tour.report['leftover_length_m']:,.1f} m")

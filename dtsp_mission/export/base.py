@@ -9,6 +9,7 @@ from pathlib import Path
 import numpy as np
 
 from ..errors import InputError
+from ..frame import LocalFrame
 from ..files import write_atomic
 from ..mission import Mission, VehicleMission
 from ..mission.discretise import candidate_s
@@ -43,13 +44,22 @@ class Exporter:
     def write(self, product: Mission | Tour, path: str | os.PathLike) -> Path:
         return write_atomic(path, self.render_for(product, path))
 
-    def render_for(self, product: Mission | Tour, path: str | os.PathLike) -> str | bytes:
+    def render_for(self, product: Mission | Tour, path: str | os.PathLike,
+                   frame: LocalFrame | None = None) -> str | bytes:
         """The file's content for ``path``, or :class:`InputError` if this format needs a
-        mission and ``product`` is a bare tour."""
+        mission and ``product`` is a bare tour.  ``frame`` places a bare tour on the earth for
+        formats that can say where it is (:meth:`render_tour`)."""
         if self.needs_mission and not isinstance(product, Mission):
             raise InputError(f"{path}: a {self.description or self.name} needs a mission in "
                              "degrees; give targets in lat/lon, or local x/y with --origin")
+        if isinstance(product, Tour) and frame is not None:
+            return self.render_tour(product, frame)
         return self.render(product)
+
+    def render_tour(self, tour: Tour, frame: LocalFrame) -> str | bytes:
+        """A bare tour planned in ``frame`` (formats that need no mission); by default as
+        :meth:`render` writes it."""
+        return self.render(tour)
 
     def render(self, product: Mission | Tour) -> str | bytes:
         """The complete file content."""

@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+from ..frame import LocalFrame
 from ..mission import Mission
 from ..tour import Tour
 from ..tour.json_form import dumps
@@ -20,3 +21,6 @@ class TourJSONExporter(Exporter):
         if isinstance(product, Mission):
             return dumps(product.tour, (product.frame.origin_lat_deg, product.frame.origin_lon_deg))
         return dumps(product)
+
+    def render_tour(self, tour: Tour, frame: LocalFrame) -> str:
+        return dumps(tour, (frame.origin_lat_deg, frame.origin_lon_deg))

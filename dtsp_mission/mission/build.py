@@ -15,7 +15,7 @@ from typing import Callable
 
 import numpy as np
 
-from ..errors import DtspError, InputError
+from ..errors import DtspError, InputError, MissionTooLarge
 from ..frame import LocalFrame
 from ..targets import GeoTargets
 from ..tour import Tour
@@ -118,12 +118,12 @@ def _fit_waypoints(path: FlightPath, rho_m: float, settings: MissionSettings) ->
     coarse = waypoint_s(path.chain, rho_m, path.target_s_m, settings.tolerance_m)
     if len(coarse) > budget:
         needed = len(coarse) - 1 + _fixed_items(settings)
-        raise InputError(
+        raise MissionTooLarge(
             f"the mission needs {needed} items at a waypoint tolerance of "
             f"{settings.tolerance_m:.3g} m but the vehicle holds {settings.max_items} "
             f"(--max-items). Allow more items if the vehicle has the space (ArduPilot with the "
             f"mission on SD card, BRD_SD_MISSION, holds about 4,300), accept a coarser "
-            f"--tolerance, or split the targets into several missions")
+            f"--tolerance, or split the targets into several missions", needed, settings.max_items)
     low, high, chosen = fine, settings.tolerance_m, coarse
     for _ in range(12):
         middle = math.sqrt(low * high)
@@ -145,11 +145,12 @@ def _design_for_guidance(path: FlightPath, tour: Tour, frame: LocalFrame, target
     budget = settings.max_items - _fixed_items(settings) - len(tail)
     needed = len(tour.targets_m)
     if budget < needed:
-        raise InputError(
+        raise MissionTooLarge(
             f"the mission needs at least {needed + _fixed_items(settings) + len(tail)} items (one "
             f"per target) but the vehicle holds {settings.max_items} (--max-items): allow more "
             "if it has the space (ArduPilot with the mission on SD card holds about 4,300) or "
-            "split the targets into several missions")
+            "split the targets into several missions",
+            needed + _fixed_items(settings) + len(tail), settings.max_items)
     head = ([(Command.DO_CHANGE_SPEED, (0.0, float(settings.airspeed_m_s), -1.0, 0.0))]
             if settings.airspeed_m_s is not None else [])
     altitudes = (np.full(len(tour.targets_m), settings.altitude_m) if targets.altitudes_m is None

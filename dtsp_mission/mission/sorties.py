@@ -1,0 +1,115 @@
+"""Sorties: a tour too long for the vehicle's mission storage, flown as several missions.
+
+Each sortie takes off, flies a contiguous part of the tour (its legs exactly as planned) and
+returns.  The parts are chosen to balance the flight time: the cut points minimise the longest
+sortie's estimated flight (climb-out and straight way to the first target, the tour between
+its first and last target, straight way home), over every place the closed tour can be opened;
+the number of sorties is the smallest whose missions all fit ``max_items``.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import numpy as np
+
+from ..errors import InputError, MissionTooLarge
+from ..frame import LocalFrame
+from ..targets import GeoTargets
+from ..tour import Tour, tour_through_poses
+from .build import MissionSettings, build_mission
+from .model import Mission
+
+#: Most sorties tried before giving up.
+MAX_SORTIES = 64
+
+
+@dataclass(frozen=True)
+class Sortie:
+    """One mission of a split: the indices of its targets (tour order) and the mission."""
+
+    targets: np.ndarray
+    mission: Mission
+
+
+def _cuts(arc_m: np.ndarray, to_home_m: np.ndarray, count: int, first: int) -> tuple[list[int], float]:
+    """Cut the closed visiting order (legs ``arc_m[i]`` from visit i to i+1, straight distance
+    home ``to_home_m``) opened before visit ``first`` into ``count`` contiguous parts of
+    near-equal estimated flight; the part starts and the longest estimate."""
+    n = len(arc_m)
+    order = (first + np.arange(n)) % n
+    legs = arc_m[order]
+    home = to_home_m[order]
+    cumulative = np.concatenate([[0.0], np.cumsum(legs)])      # distance from the first visit
+
+    def flight(i: int, j: int) -> float:                        # visits i..j (inclusive)
+        return home[i] + cumulative[j] - cumulative[i] + home[j]
+
+    def parts_within(limit: float) -> list[int] | None:
+        starts, i = [0], 0
+        while True:
+            j = i
+            while j + 1 < n and flight(i, j + 1) <= limit:
+                j += 1
+            if j + 1 >= n:
+                return starts
+            if len(starts) == count:
+                return None
+            i = j + 1
+            starts.append(i)
+
+    low = max(flight(i, i) for i in range(n))
+    high = flight(0, n - 1)
+    for _ in range(40):
+        middle = 0.5 * (low + high)
+        if parts_within(middle) is None:
+            low = middle
+        else:
+            high = middle
+    starts = parts_within(high) or [0]
+    return [int(order[s]) for s in starts], high
+
+
+def split_into_sorties(tour: Tour, frame: LocalFrame, targets: GeoTargets,
+                       settings: MissionSettings, home_m: np.ndarray) -> list[Sortie]:
+    """The fewest sorties (at least 2) whose missions each fit ``settings.max_items``,
+    balanced by estimated flight time; :class:`InputError` if none up to :data:`MAX_SORTIES`
+    does."""
+    n = len(tour.targets_m)
+    order = tour.visit_order
+    poses = tour.visit_poses()[order]
+    s = tour.visit_s_m[order]
+    arc = np.diff(np.append(s, s[0] + tour.length_m))
+    to_home = np.hypot(*(tour.targets_m[order] - np.asarray(home_m, dtype=float)).T)
+    last_error: Exception | None = None
+    for count in range(2, min(MAX_SORTIES, n) + 1):
+        candidates = range(0, n, max(1, n // 64))
+        starts, _ = min((_cuts(arc, to_home, count, first) for first in candidates),
+                        key=lambda result: result[1])
+        pieces = []
+        for k, start in enumerate(starts):
+            end = starts[(k + 1) % len(starts)]
+            length = (end - start) % n or n
+            pieces.append((start + np.arange(length)) % n)
+        try:
+            sorties = []
+            for piece in pieces:
+                chosen = order[piece]
+                part = tour_through_poses(tour.targets_m[chosen], np.arange(len(chosen)),
+                                          poses[piece, 2], tour.rho_m, tour.planner, tour.parameters)
+                mission = build_mission(part, frame, targets.subset(chosen), settings)
+                sorties.append(Sortie(chosen, mission))
+            return sorties
+        except MissionTooLarge as error:
+            last_error = error
+    raise InputError(f"even {min(MAX_SORTIES, n)} sorties do not fit the vehicle's "
+                     f"{settings.max_items} items: {last_error}")
+
+
+def sortie_path(path: str, index: int) -> str:
+    """``mission.plan`` -> ``mission-<index>.plan`` (1-based)."""
+    stem, dot, extension = path.rpartition(".")
+    if not dot or "/" in extension:
+        return f"{path}-{index}"
+    return f"{stem}-{index}.{extension}"
+
