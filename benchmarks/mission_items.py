@@ -66,13 +66,18 @@ def _evaluate(mission, targets, airframe) -> dict:
 LIMITS = """
 ## What limits it
 
-- Targets a few metres apart in sharp turns (the bundled site: pylons 40 m apart, fence posts
-  9 m apart at the 10th percentile, tank rims) ask for turns ArduPlane's L1 guidance cannot
-  make between two waypoints; aiming and shaping hold about two thirds of them. A wider planned
-  turn does not help there (the margin search keeps rho 80 m).
-- On clustered sites of 400 targets the design runs into the 655-item budget (1.64 items per
-  target): the shaping waypoints that would hold the rest do not fit. A split into sorties is
-  not built yet.
+- Lines of targets closer together than ArduPlane's L1 distance (NAVL1_PERIOD 15 s: about 79 m
+  at 22 m/s), entered from a turn: the guidance needs a few hundred metres of line to settle,
+  so the first posts of the bundled site's fence (40 m apart) and tank rims are passed 10-55 m
+  off; aiming and shaping waypoints on the exact path cannot straighten an entry the tour does
+  not have. The bundled site: 41 of 272 targets beyond 5 m at 1.01 items per target (105 with
+  the tours before the improvement stage), the predicted flight 21 % shorter than the exact path
+  (the aircraft cuts the loops it cannot fly).
+- Clustered sites (Gaussian clusters, sigma 150 m): 10 of 100 and 31 of 400 targets beyond 5 m,
+  at 1.51 and 1.64 items per target; the 400-target site is held back by the 655-item budget
+  (the shaping waypoints that would hold the rest do not fit). A mission that does not fit at
+  all is split into sorties (`plan` writes `mission-1.plan`, ...; `docs/missions.md`); a
+  design that fits but is budget-bound is not split.
 - The design trusts the flight model: its agreement with real ArduPlane flights is measured in
   `arduplane-agreement.md` (closest approach within about 1 m of ArduPlane's on the recorded
   dtsp-mission missions); nothing here was flown by a real ArduPlane.

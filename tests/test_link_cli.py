@@ -80,7 +80,7 @@ def test_plan_simulate_and_upload_in_one_go(tmp_path, start_vehicle, mission):
     vehicle = start_vehicle(mission, max_items=4000)   # with SD storage: the site needs ~1,800 items
     out = tmp_path / "site.plan"
     result = run("plan", SITE, "--radius", 80, "--alt", 120, "--airspeed", 22, "--max-items",
-                 4000, "-o", out, "--upload", f"udpout:127.0.0.1:{vehicle.port}")
+                 4000, "--time-limit", 1, "-o", out, "--upload", f"udpout:127.0.0.1:{vehicle.port}")
     assert result.exit_code == 0, result.output
     assert out.exists() and "holds exactly the planned mission" in result.output
     assert len(vehicle.mission) == len(exporter_for(out).read(out).items) + 1
@@ -111,7 +111,7 @@ def test_sim_command_runs_as_a_process_and_accepts_uploads(mission, tmp_path):
 
 def test_upload_a_tour_json_builds_the_mission_with_plan_options(tmp_path, start_vehicle, mission):
     tour = tmp_path / "tour.json"
-    result = run("plan", SITE, "--radius", 80, "--max-items", 4000, "-o", tour)
+    result = run("plan", SITE, "--radius", 80, "--max-items", 4000, "--time-limit", 1, "-o", tour)
     assert result.exit_code == 0, result.output
     vehicle = start_vehicle(mission, max_items=4000, autopilot=Autopilot.PX4)   # with SD storage
     result = run("upload", tour, "--connect", f"udpout:127.0.0.1:{vehicle.port}",

@@ -26,7 +26,7 @@ def run(*arguments):
 
 def test_site_example_to_every_format_and_a_plot(tmp_path):
     outputs = [tmp_path / name for name in ("m.plan", "m.waypoints", "m.geojson", "m.json")]
-    arguments = [SITE, "--radius", "80", "--alt", "120", "--airspeed", "22", "--max-items", "4000",
+    arguments = [SITE, "--radius", "80", "--alt", "120", "--airspeed", "22", "--max-items", "4000", "--time-limit", "1",
                  "--plot", tmp_path / "m.png"]
     for output in outputs:
         arguments += ["-o", output]

@@ -32,6 +32,8 @@ from .instances import area_m2, instance
 from .measure import format_table
 
 ANCHOR = AnchorPlanner.name
+#: Families whose targets are uniform: the stochastic lower bound applies to them.
+UNIFORM_FAMILIES = ("uniform", "dense")
 #: The bundled site is planned at the turn radius its missions are flown with.
 SITE_RHO_M = 80.0
 
@@ -115,7 +117,9 @@ def run(sizes: Iterable[int], seeds: int, rho_m: float, side_m: float, names: li
             targets = instance(family, n, seed, side_m)
             n = len(targets)
             rho = SITE_RHO_M if family == "site" else rho_m
-            bound = lower_bound(targets, rho, area_m2(family, targets, side_m)).value_m
+            bounds = lower_bound(targets, rho, area_m2(family, targets, side_m))
+            # The stochastic bound holds for uniform targets only; elsewhere the certified one.
+            bound = bounds.value_m if family in UNIFORM_FAMILIES else bounds.one_tree_m
             measured = []
             for name in names:
                 progress(f"{family} n={n} seed={seed} {name}")
@@ -169,7 +173,8 @@ def table(runs: list[PlannerRun]) -> str:
     return format_table(header(runs), summary_rows(runs))
 
 
-def markdown(runs: list[PlannerRun], command: str, side_m: float, rho_m: float) -> str:
+def markdown(runs: list[PlannerRun], command: str, side_m: float, rho_m: float,
+             merged: bool = False) -> str:
     """The summary as a Markdown table, with the command that produced it."""
     columns = header(runs)
     lines = ["| " + " | ".join(columns) + " |", "|" + " --- |" * len(columns)]
@@ -185,7 +190,11 @@ def markdown(runs: list[PlannerRun], command: str, side_m: float, rho_m: float) 
             f"site at rho {SITE_RHO_M:g} m; rho {rho_m:g} m otherwise; sizes "
             f"{', '.join(map(str, sizes))}, {seeds} seeds; medians over seeds; time is one "
             "planning run on one core, peak memory as traced by tracemalloc). Not typed: rerun "
-            "the command to refresh it.\n\n" + "\n".join(lines) + "\n"
+            "the command to refresh it."
+            + (" The runs are merged from the files named, each written by `bench planners "
+               "--json` (how each was measured: `benchmarks/README.md`; the anchor's runs shared "
+               "the machine with a second benchmark process, one per core)." if merged else "")
+            + "\n\n" + "\n".join(lines) + "\n"
             + ("\nRuns without a tour:\n\n" + "\n".join(notes) + "\n" if notes else ""))
 
 
@@ -201,6 +210,26 @@ def as_csv(runs: list[PlannerRun]) -> str:
 def as_json(runs: list[PlannerRun]) -> str:
     return json.dumps([dict(asdict(r), over_bound=r.over_bound, over_best=r.over_best,
                             over_anchor=r.over_anchor) for r in runs], indent=1) + "\n"
+
+
+def recombine(runs: list[PlannerRun]) -> list[PlannerRun]:
+    """Runs gathered from several measurements as one: a later run of the same planner on the
+    same instance replaces an earlier one, and each instance's best of run and anchor length
+    are taken anew over what is there."""
+    from dataclasses import replace
+    latest = {(r.family, r.n, r.seed, r.planner): r for r in runs}
+    merged = list(latest.values())
+    instances: dict[tuple, list[PlannerRun]] = {}
+    for r in merged:
+        instances.setdefault((r.family, r.n, r.seed), []).append(r)
+    result = []
+    for group in instances.values():
+        lengths = [r.length_m for r in group if r.valid]
+        best = min(lengths) if lengths else float("nan")
+        anchor = next((r.length_m for r in group if r.planner == ANCHOR and r.valid), float("nan"))
+        bound = min(r.lower_bound_m for r in group)      # the bound is the instance's, not a run's
+        result += [replace(r, best_m=best, anchor_m=anchor, lower_bound_m=bound) for r in group]
+    return result
 
 
 def from_json(path) -> list[PlannerRun]:

@@ -66,7 +66,8 @@ def _sizes(ctx, param, value: str) -> list[int]:
               help="auto's improvement budget in reference seconds (default: auto's own).")
 @click.option("--merge", "merge_files", multiple=True, type=click.Path(exists=True, dir_okay=False),
               help="Measure nothing: tabulate the runs of earlier --json outputs (repeatable; "
-                   "e.g. families measured on separate cores).")
+                   "e.g. families measured on separate cores; a later file's run of a planner on "
+                   "an instance replaces an earlier one, so the slow anchor need not be rerun).")
 @click.option("--csv", "csv_file", type=click.Path(dir_okay=False), help="Write every run as CSV.")
 @click.option("--json", "json_file", type=click.Path(dir_okay=False), help="Write every run as JSON.")
 @click.option("--markdown", "markdown_file", type=click.Path(dir_okay=False),
@@ -103,7 +104,8 @@ def planners_bench(sizes, seeds, rho_m, side_m, names, families, anchor, time_li
         chosen.append(AnchorPlanner.name)
     steps = sum(1 if f == "site" else len(sizes) * seeds for f in family_list) * len(chosen)
     if merge_files:
-        runs = [run for path in merge_files for run in planner_bench.from_json(path)]
+        runs = planner_bench.recombine(
+            [run for path in merge_files for run in planner_bench.from_json(path)])
         family_list = list(dict.fromkeys(r.family for r in runs))
         seeds = len({r.seed for r in runs})
     else:
@@ -125,7 +127,8 @@ def planners_bench(sizes, seeds, rho_m, side_m, names, families, anchor, time_li
         "dtsp-mission bench planners"
     for path, content in ((csv_file, lambda: planner_bench.as_csv(runs)),
                           (json_file, lambda: planner_bench.as_json(runs)),
-                          (markdown_file, lambda: planner_bench.markdown(runs, command, side_m, rho_m)),
+                          (markdown_file, lambda: planner_bench.markdown(runs, command, side_m, rho_m,
+                                                                        bool(merge_files))),
                           (plot_file, lambda: planner_bench.plot_png(runs, side_m, rho_m))):
         if path:
             write_atomic(path, content())
