@@ -29,9 +29,10 @@ def _d(points, a, b):
 
 
 @numba.njit(**_JIT)
-def _reverse(tour, pos, i, j):
+def reverse_section(tour, pos, i, j):
     """Reverse tour positions i..j (forward, cyclic), or the complement if it is shorter;
-    either gives the same cyclic tour."""
+    either gives the same cyclic tour.  Returns the first position and the length of the
+    section actually reversed."""
     n = tour.shape[0]
     length = (j - i) % n + 1
     if 2 * length > n:
@@ -43,6 +44,7 @@ def _reverse(tour, pos, i, j):
         a, b = tour[p], tour[q]
         tour[p], tour[q] = b, a
         pos[b], pos[a] = p, q
+    return i, length
 
 
 @numba.njit(**_JIT)
@@ -51,9 +53,9 @@ def _exchange(tour, pos, a, b, c, d):
     in one of its two orientations."""
     n = tour.shape[0]
     if tour[(pos[a] + 1) % n] == b:
-        _reverse(tour, pos, pos[b], pos[c])
+        reverse_section(tour, pos, pos[b], pos[c])
     else:
-        _reverse(tour, pos, pos[c], pos[b])
+        reverse_section(tour, pos, pos[c], pos[b])
 
 
 @numba.njit(**_JIT)

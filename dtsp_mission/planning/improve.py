@@ -44,7 +44,7 @@ import numba
 import numpy as np
 
 from ..dubins.kernel import solve_pair
-from .euclidean_tour import neighbour_lists
+from .euclidean_tour import neighbour_lists, reverse_section
 from .headings import edge_directions, headings_over_candidates, straight_through_headings
 
 _JIT = dict(cache=True, error_model="numpy")
@@ -130,18 +130,9 @@ def _reverse(tour, pos, hd, i, j):
     """Reverse positions i..j (forward, cyclic) with every heading there turned by pi, or the
     rest of the tour likewise if it is shorter: both give tours of the same legs."""
     n = tour.shape[0]
-    length = (j - i) % n + 1
-    if 2 * length > n:
-        i, j = (j + 1) % n, (i - 1) % n
-        length = n - length
-    for k in range(length // 2):
-        p = (i + k) % n
-        q = (j - k) % n
-        a, b = tour[p], tour[q]
-        tour[p], tour[q] = b, a
-        pos[b], pos[a] = p, q
+    start, length = reverse_section(tour, pos, i, j)
     for k in range(length):
-        c = tour[(i + k) % n]
+        c = tour[(start + k) % n]
         hd[c] = _wrap(hd[c] + _PI)
 
 
