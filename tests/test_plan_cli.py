@@ -14,6 +14,11 @@ EXAMPLE = Path(__file__).parents[1] / "examples" / "site-local.csv"
 
 
 def run(*arguments):
+    """``dtsp-mission plan``; auto's improvement budget is 1 s unless given (the improver is
+    tested on its own in tests/planning/test_improve.py)."""
+    arguments = [*map(str, arguments)]
+    if "--time-limit" not in arguments:
+        arguments += ["--time-limit", "1"]
     return subprocess.run([sys.executable, "-m", "dtsp_mission.cli", "plan", *arguments],
                           capture_output=True, text=True, timeout=300)
 

@@ -20,13 +20,18 @@ AREA = EXAMPLES / "survey-area.geojson"
 
 
 def run(*arguments):
-    return subprocess.run([sys.executable, "-m", "dtsp_mission.cli", "plan", *map(str, arguments)],
+    """``dtsp-mission plan`` with the arguments; auto's improvement budget is 1 s unless given
+    (these tests are about missions, the improver is tested on its own)."""
+    arguments = [*map(str, arguments)]
+    if "--time-limit" not in arguments:
+        arguments += ["--time-limit", "1"]
+    return subprocess.run([sys.executable, "-m", "dtsp_mission.cli", "plan", *arguments],
                           capture_output=True, text=True, timeout=300)
 
 
 def test_site_example_to_every_format_and_a_plot(tmp_path):
     outputs = [tmp_path / name for name in ("m.plan", "m.waypoints", "m.geojson", "m.json")]
-    arguments = [SITE, "--radius", "80", "--alt", "120", "--airspeed", "22", "--max-items", "4000", "--time-limit", "1",
+    arguments = [SITE, "--radius", "80", "--alt", "120", "--airspeed", "22", "--max-items", "4000",
                  "--plot", tmp_path / "m.png"]
     for output in outputs:
         arguments += ["-o", output]
