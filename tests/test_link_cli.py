@@ -87,24 +87,28 @@ def test_plan_simulate_and_upload_in_one_go(tmp_path, start_vehicle, mission):
 
 
 def test_sim_command_runs_as_a_process_and_accepts_uploads(mission, tmp_path):
+    """Over TCP, as to ArduPilot SITL (tcp:127.0.0.1:5760): the same link syntax both sides."""
+    import socket
     path = tmp_path / "m.plan"
     exporter_for(path).write(mission, path)
-    port = free_udp_port()
+    with socket.socket() as probe:
+        probe.bind(("127.0.0.1", 0))
+        port = probe.getsockname()[1]
     process = subprocess.Popen(
-        [sys.executable, "-m", "dtsp_mission.cli", "sim", "--listen", f"127.0.0.1:{port}",
+        [sys.executable, "-m", "dtsp_mission.cli", "sim", "--listen", f"tcp:127.0.0.1:{port}",
          "--home", f"{mission.home.latitude_deg},{mission.home.longitude_deg}",
          "--radius", "80", "--airspeed", "20", "--speedup", "400", "--autostart"],
         stdout=subprocess.PIPE, stderr=subprocess.STDOUT, text=True,
         env={**os.environ, "PYTHONUNBUFFERED": "1"})
     try:
         time.sleep(1.5)
-        result = run("upload", path, "--connect", f"udpout:127.0.0.1:{port}")
+        result = run("upload", path, "--connect", f"tcp:127.0.0.1:{port}")
         assert result.exit_code == 0, result.output
         time.sleep(5)      # about 250 s of flight at 400x, and the sim's 0.2 s report cycle
     finally:
         process.terminate()
         output, _ = process.communicate(timeout=10)
-    assert "listening on udp 127.0.0.1" in output
+    assert f"connect with tcp:127.0.0.1:{port}" in output
     assert f"mission received: {len(to_wire(mission.for_vehicle()))} items" in output
     assert "mission complete" in output
 

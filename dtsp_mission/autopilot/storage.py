@@ -161,3 +161,89 @@ def comparable(item: WireItem, autopilot: Autopilot, sent: bool = True) -> WireI
 def capacity(autopilot: Autopilot) -> int:
     """Mission slots of a stock vehicle of this autopilot (ArduPilot's home slot included)."""
     return CAPACITY[autopilot]
+
+
+# -- how a vehicle writes an upload --------------------------------------------------------------
+
+#: MAV_MISSION_RESULT values the store answers with.
+ACCEPTED, ERROR, NO_SPACE = 0, 1, 4
+
+
+class MissionStore:
+    """The mission slots of one vehicle, written the way its autopilot writes an upload.
+
+    ArduPilot (``AP_Mission`` behind ``MissionItemProtocol``) is not atomic: MISSION_COUNT
+    truncates the stored mission to the new count, every item is written in place as it
+    arrives (replacing the old item at its seq, or appended), and seq 0 is always its own
+    home.  So an upload that breaks off after k items leaves the first k items of the new
+    mission followed by what is left of the old one, up to the new count -- and that is what
+    it downloads and what it flies.  PX4 receives into a second buffer and switches to it only
+    when the whole mission has arrived: a broken upload leaves the old mission.
+
+    Guarantees: :attr:`items` is at every moment exactly what a download returns and what a
+    MISSION_START would fly (items as :func:`stored_item` keeps them).
+    """
+
+    def __init__(self, autopilot: Autopilot, slots: int | None = None,
+                 home: WireItem | None = None) -> None:
+        self.autopilot = autopilot
+        self.slots = capacity(autopilot) if slots is None else slots
+        self.home = home
+        self.in_place = autopilot == Autopilot.ARDUPILOTMEGA
+        self.items: list[WireItem] = self._empty()
+        self._staged: list[WireItem] | None = None
+
+    def _empty(self) -> list[WireItem]:
+        return [self.home] if self.in_place and self.home is not None else []
+
+    def clear(self) -> None:
+        """MISSION_CLEAR_ALL: no mission (ArduPilot keeps its home slot)."""
+        self.items = self._empty()
+        self._staged = None
+
+    def replace(self, items: list[WireItem]) -> None:
+        """Hold exactly ``items`` (as sent; stored as the autopilot stores them)."""
+        self.begin(len(items))
+        for item in items:
+            self.write(item)
+        self.complete()
+
+    def begin(self, count: int) -> int:
+        """A MISSION_COUNT of ``count`` items: NO_SPACE beyond the slots (nothing changes),
+        else ACCEPTED, with ArduPilot's mission truncated to ``count`` (never below its home)."""
+        if count > self.slots:
+            return NO_SPACE
+        if self.in_place:
+            self.items = self.items[:max(count, 1 if self.home is not None else 0)]
+        else:
+            self._staged = []
+        return ACCEPTED
+
+    def write(self, item: WireItem) -> int:
+        """Item ``item.seq`` of the upload begun last: ACCEPTED, or ERROR for a seq beyond the
+        end of what is stored (ArduPilot) or out of order (PX4)."""
+        stored = replace(stored_item(item, self.autopilot), current=0)
+        if not self.in_place:
+            if self._staged is None or item.seq != len(self._staged):
+                return ERROR
+            self._staged.append(stored)
+            return ACCEPTED
+        if item.seq == 0 and self.home is not None:
+            stored = self.home                     # ArduPilot keeps its own home at seq 0
+        if item.seq < len(self.items):
+            self.items[item.seq] = stored
+        elif item.seq == len(self.items):
+            self.items.append(stored)
+        else:
+            return ERROR
+        return ACCEPTED
+
+    def complete(self) -> None:
+        """The last item arrived: PX4 switches to the new mission."""
+        if not self.in_place and self._staged is not None:
+            self.items = self._staged
+        self._staged = None
+
+    def abort(self) -> None:
+        """The upload broke off: PX4 drops the partial mission; ArduPilot keeps what it wrote."""
+        self._staged = None

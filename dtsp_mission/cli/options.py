@@ -5,6 +5,7 @@ from __future__ import annotations
 
 import functools
 import sys
+import time
 from typing import Callable
 
 import click
@@ -156,6 +157,9 @@ link_options = [
     click.option("--signing-key", "signing_key_file", type=click.Path(dir_okay=False),
                  metavar="FILE", help="Sign with this MAVLink 2 key: 32 bytes, 64 hex digits, "
                                       "or a passphrase (its SHA-256)."),
+    click.option("--timeout", "transfer_timeout_s", type=float, metavar="S",
+                 help="Give up a transfer (the upload, the verification download) after this "
+                      "long.  Default: 30 s + 0.1 s per item."),
 ]
 
 #: The simulated aircraft's autopilot, defined once for `sim`, `fly` and `plan --simulate`.
@@ -174,18 +178,22 @@ simulation_options = [
 
 
 def progress_reporter(label: str):
-    """A ``progress(done, total)`` callback drawing a bar on stderr, and its closer; nothing
-    is drawn when stderr is not a terminal (a log file gets no bar fragments)."""
+    """A ``progress(done, total[, resent])`` callback drawing a bar on stderr (with the rate
+    and, for transfers, the messages sent again), and its closer; nothing is drawn when stderr
+    is not a terminal (a log file gets no bar fragments)."""
     state: dict = {}
     stream = sys.stderr
 
-    def progress(done: int, total: int) -> None:
+    def progress(done: int, total: int, resent: int | None = None) -> None:
         if not (hasattr(stream, "isatty") and stream.isatty()):
             return
         if "bar" not in state:
             state["bar"] = click.progressbar(length=total, label=label, file=stream)
             state["bar"].__enter__()
-            state["done"] = 0
+            state["done"], state["since"] = 0, time.monotonic()
+        if resent is not None:
+            rate = done / max(1e-9, time.monotonic() - state["since"])
+            state["bar"].label = f"{label} ({rate:.0f} items/s, {resent} resent)"
         state["bar"].update(done - state["done"])
         state["done"] = done
 

@@ -141,8 +141,8 @@ def plan(targets_file, random_count, area_file, seed, origin, rho_m, airspeed_m_
          altitude_m, home_deg, home_amsl_m, launch_bearing_deg, landing_bearing_deg, autopilot,
          return_mode, design, max_miss_m, tolerance_m, max_items, algorithm, region, time_limit_s,
          fallback, outputs, format_name,
-         plot_file, connection, via, verify, signing_key_file, simulate, speedup, vehicle_params_file,
-         l1_period_s) -> None:
+         plot_file, connection, via, verify, signing_key_file, transfer_timeout_s, simulate, speedup,
+         vehicle_params_file, l1_period_s) -> None:
     """Plan a Dubins tour through the targets and write it as a mission.
 
     TARGETS_FILE: CSV with lat,lon columns (optional alt, name), or local x,y metres (with
@@ -266,7 +266,8 @@ def plan(targets_file, random_count, area_file, seed, origin, rho_m, airspeed_m_
     if connection:
         from .upload_command import run_upload
         run_upload(product.for_vehicle(), connection, via, verify, signing_key_file,
-                   designed_for=_designed_for(vehicle_params_file))
+                   designed_for=_designed_for(vehicle_params_file),
+                   transfer_timeout_s=transfer_timeout_s)
 
 
 def _split(tour, frame, geodetic, settings, error):

@@ -52,8 +52,11 @@ def airframe_from(vehicle_params_file, airspeed_m_s, max_bank_deg, l1_period_s,
 
 
 @click.command()
-@click.option("--listen", default="127.0.0.1:14550", show_default=True, metavar="HOST:PORT",
-              help="UDP address the vehicle listens on (ground stations use udpout:HOST:PORT).")
+@click.option("--listen", default="127.0.0.1:14550", show_default=True, metavar="LINK",
+              help="Where the vehicle listens: HOST:PORT or udp:HOST:PORT (ground stations "
+                   "connect with udpout:HOST:PORT), tcp:HOST:PORT (as ArduPilot SITL's "
+                   "tcp:127.0.0.1:5760), or pty (a pseudo-terminal: ground stations open the "
+                   "printed device as a serial port).")
 @click.option("--gcs", metavar="HOST:PORT", help="Also send to a ground station listening here "
               "(QGroundControl listens on 127.0.0.1:14550) before it speaks.")
 @click.option("--home", "home_deg", type=LAT_LON, required=True, help="Where the vehicle stands.")
@@ -80,18 +83,19 @@ def sim(listen, gcs, home_deg, home_amsl_m, autopilot, rho_m, airspeed_m_s, max_
     """
     airframe, parameters, source = airframe_from(vehicle_params_file, airspeed_m_s, max_bank_deg,
                                                  l1_period_s, rho_m)
-    host, port = _address(listen)
     settings = VehicleSettings(Home(*home_deg, home_amsl_m), AUTOPILOTS[autopilot], airframe,
                                speedup, max_items=max_items, autostart=autostart,
                                signing_key=read_signing_key(signing_key_file) if signing_key_file else None,
                                parameters=parameters)
     try:
-        vehicle = SimulatedVehicle(settings, port, host, _address(gcs) if gcs else None)
+        vehicle = SimulatedVehicle(settings, gcs=_address(gcs) if gcs else None, listen=listen)
+    except ValueError as error:
+        raise UserError(str(error)) from None
     except OSError as error:
         raise UserError(f"cannot listen on {listen}: {error.strerror}") from None
     with vehicle:
         click.echo(f"simulated {autopilot} fixed wing at {home_deg[0]:.6f},{home_deg[1]:.6f}; "
-                   f"{source}; listening on udp {vehicle.host}:{vehicle.port} (Ctrl-C stops)")
+                   f"{source}; connect with {vehicle.connection} (Ctrl-C stops)")
         uploads, reached = 0, 0
         try:
             while True:

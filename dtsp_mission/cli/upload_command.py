@@ -11,24 +11,26 @@ from .options import (UserError, apply, link_options, mission_options, mission_s
 
 
 def run_upload(mission, connection: str, via: str, verify: bool, signing_key_file: str | None,
-               heartbeat_timeout_s: float | None = None, designed_for=None) -> None:
+               heartbeat_timeout_s: float | None = None, designed_for=None,
+               transfer_timeout_s: float | None = None) -> None:
     """Upload with a progress bar and print what happened (shared with ``plan --upload``)."""
     key = read_signing_key(signing_key_file) if signing_key_file else None
     progress, close = progress_reporter("uploading")
     slots = len(to_wire(mission))
     home = " and the home slot" if slots > len(mission.items) else ""
-    click.echo(f"uploading {len(mission.items)} mission items{home} ({slots} vehicle slots) to "
+    click.echo(f"uploading {len(mission.items)} mission items{home} ({slots} mission slots) to "
                f"{connection} via {via}")
     try:
         report = upload_mission(mission, connection, via=via, verify=verify, signing_key=key,
                                 progress=progress, heartbeat_timeout_s=heartbeat_timeout_s,
-                                designed_for=designed_for)
+                                designed_for=designed_for, timeout_s=transfer_timeout_s)
     finally:
         close()
     for warning in report.warnings:
         click.echo(f"warning: {warning}", err=True)
-    line = (f"the vehicle accepted {report.items} items in {report.seconds:.2f} s "
-            f"({report.resent} resent)")
+    fresh = f", {report.fresh_starts} fresh starts" if report.fresh_starts else ""
+    line = (f"the vehicle accepted {report.items} mission slots in {report.seconds:.2f} s "
+            f"({report.resent} messages resent{fresh})")
     click.echo(line + ("; downloaded back: it holds exactly the planned mission" if report.verified
                        else "; not verified (--no-verify)"))
     if report.note:
@@ -51,8 +53,8 @@ def run_upload(mission, connection: str, via: str, verify: bool, signing_key_fil
               "navigation parameter the vehicle has otherwise is warned about (default: a "
               "stock ArduPlane's).")
 @reports_errors
-def upload(mission_file, connection, via, verify, signing_key_file, format_name,
-           heartbeat_timeout_s, vehicle_params_file, **mission_option_values) -> None:
+def upload(mission_file, connection, via, verify, signing_key_file, transfer_timeout_s,
+           format_name, heartbeat_timeout_s, vehicle_params_file, **mission_option_values) -> None:
     """Upload MISSION_FILE (.plan, .waypoints, or a tour .json) to a vehicle over MAVLink.
 
     A tour .json (from `plan -o tour.json`, with its frame origin) becomes a mission here,
@@ -64,6 +66,12 @@ def upload(mission_file, connection, via, verify, signing_key_file, format_name,
     the mission is downloaded back and compared item by item, as the autopilot stores items
     (ArduPilot uploads are not atomic); on any failure the message says what the vehicle holds.
 
+    Links: udpout:HOST:PORT (send to a vehicle listening there), udpin:0.0.0.0:PORT (listen
+    for a vehicle sending here), tcp:HOST:PORT (ArduPilot SITL: tcp:127.0.0.1:5760), a
+    serial device with its baud rate (/dev/ttyACM0,57600 or COM3,57600), as MAVProxy's
+    --master writes them.  Lost, repeated and reordered messages are repeated and ignored as
+    the link needs; a vehicle that gives an upload up gets a fresh one, within --timeout.
+
     Example: dtsp-mission upload mission.plan --connect udpout:127.0.0.1:14550
     """
     from ..export import exporter_for, read_mission
@@ -73,7 +81,7 @@ def upload(mission_file, connection, via, verify, signing_key_file, format_name,
         mission = read_mission(mission_file, format_name)
     from .plan_command import _designed_for
     run_upload(mission, connection, via, verify, signing_key_file, heartbeat_timeout_s,
-               _designed_for(vehicle_params_file))
+               _designed_for(vehicle_params_file), transfer_timeout_s)
 
 
 def _tour_mission(path, settings):

@@ -9,6 +9,7 @@ the flight time is the simulator's clock.
 from __future__ import annotations
 
 import math
+import socket
 import time
 from dataclasses import dataclass
 from typing import Callable
@@ -96,7 +97,7 @@ def fly_mission(mission: VehicleMission, targets: Targets, airframe: Airframe,
     with SimulatedVehicle(settings) as vehicle:
         connection = f"udpout:127.0.0.1:{vehicle.port}"
         report = upload_mission(mission, connection, via=via,
-                                progress=(lambda d, t: progress("upload", d, t)) if progress else None)
+                                progress=(lambda d, t, _resent: progress("upload", d, t)) if progress else None)
         track, reached = _watch(vehicle, connection, mission, speedup, progress, timeout_s)
         flight_time = vehicle.log.reached[-1][1] if vehicle.log.reached else 0.0
         items = len(vehicle.mission)
@@ -126,6 +127,10 @@ def _watch(vehicle: SimulatedVehicle, connection: str, mission: VehicleMission, 
     use_mavlink2()
     link = mavutil.mavlink_connection(connection, source_system=GCS_SYSTEM_ID,
                                       source_component=GCS_COMPONENT_ID)
+    try:   # at a high --speedup telemetry comes in bursts: room for them, so none is dropped
+        link.port.setsockopt(socket.SOL_SOCKET, socket.SO_RCVBUF, 8 << 20)
+    except (AttributeError, OSError):
+        pass
     rows = []
     highest = -1
     last_seq = len(vehicle.mission) - 1

@@ -1,19 +1,25 @@
-"""A simulated fixed-wing vehicle that speaks MAVLink: MAVSDK's server plugins take uploads and
-serve telemetry, the vehicle's own code serves downloads from what it stored (as the autopilot
-stores items, :mod:`dtsp_mission.autopilot.storage`), and
-:class:`~dtsp_mission.autopilot.navigation.MissionFlight` flies.
+"""A simulated fixed-wing vehicle that speaks MAVLink: the mission protocol is served by the
+vehicle's own code as ArduPilot runs it (:mod:`.mission_server`, on the autopilot's
+:class:`~dtsp_mission.autopilot.storage.MissionStore`: items written in place as they arrive,
+what it downloads is what it flies), :class:`~dtsp_mission.autopilot.navigation.MissionFlight`
+flies and the vehicle's encoder reports its positions (MAVSDK supplies the heartbeat,
+AUTOPILOT_VERSION and the home position).
 
-MAVSDK runs on a ``raw://`` connection; this module owns the UDP socket and sits between it
-and the ground station, adding what the server plugins do not do: a heartbeat as a fixed
-wing of the chosen autopilot, an item limit answered with MAV_MISSION_NO_SPACE, MAVLink 2
-signing, MAV_CMD_MISSION_START, and a restart (fault injection).  Everything else -- upload,
-download, MISSION_CURRENT, MISSION_ITEM_REACHED, positions -- is MAVSDK's.
+Why not MAVSDK's ``mission_raw_server``: it accepts a mission only as a whole and hands it
+over after its final ACK, so after an upload that broke off it cannot hold what an ArduPilot
+holds (the first items of the new mission), and under 5 % loss with duplicates and
+reordering 4 of 5 verification downloads from it stalled (measured for the upload issue).
+
+MAVSDK runs on a ``raw://`` connection; this module owns the link (:mod:`.transport`: UDP,
+TCP or a pseudo-terminal) and sits between it and the ground station, adding a heartbeat as a
+fixed wing of the chosen autopilot, parameters and home on request, MAVLink 2 signing,
+MAV_CMD_MISSION_START, MISSION_CURRENT / MISSION_ITEM_REACHED while flying, and a restart
+(fault injection).
 """
 
 from __future__ import annotations
 
 import math
-import socket
 import threading
 import time
 from dataclasses import dataclass, field
@@ -23,12 +29,14 @@ from pymavlink.dialects.v20 import common as mavlink2
 
 from ..autopilot.navigation import Airframe, LocalItem, MissionFlight, local_items
 from ..autopilot.parameters import ARDUPLANE_DEFAULTS, NAMES, VehicleParameters, parameter_name
-from ..autopilot.storage import capacity, stored_item
+from ..autopilot.storage import MissionStore, stored_item
 from ..frame import LocalFrame
 from ..mavsdk_log import quiet_mavsdk_log
 from ..mission import Autopilot
 from ..mission.model import Home, degrees_to_e7
 from ..upload.wire import WireItem, first_mission_seq, home_placeholder
+from .mission_server import MissionServer
+from .transport import Transport, UdpTransport, open_transport
 from ..vehicle import heading_to_bearing_deg
 
 MAV_TYPE_FIXED_WING = 1
@@ -38,8 +46,6 @@ MAVLINK_MSG_ID_HOME_POSITION = 242
 MAV_PARAM_TYPE_REAL32 = 9
 MAV_RESULT_ACCEPTED = 0
 MAV_RESULT_DENIED = 2
-MAV_MISSION_NO_SPACE = 4
-MAV_MISSION_INVALID_SEQUENCE = 13
 MAV_STATE_STANDBY, MAV_STATE_ACTIVE = 3, 4
 MAV_MODE_FLAG_CUSTOM_MODE_ENABLED = 1
 MAV_MODE_FLAG_AUTO_ENABLED = 4
@@ -64,6 +70,8 @@ class VehicleSettings:
     autostart: bool = False           # fly as soon as a mission arrives
     restart_at_item: int | None = None   # fault: reboot when this item arrives in an upload
     restart_s: float = 1.0            # how long a reboot keeps it silent (wall seconds)
+    upload_timeout_s: float = 8.0     # an upload without an item this long is cancelled
+                                      # (ArduPilot's MissionItemProtocol: 8 s)
     parameters: VehicleParameters = ARDUPLANE_DEFAULTS   # what it answers PARAM_REQUEST_READ with
 
 
@@ -87,20 +95,21 @@ class _Sender:
 
 
 class SimulatedVehicle:
-    """The vehicle, listening on ``udpin`` ``host:port`` (port 0 picks a free one).  Ground
-    stations connect with ``udpout:HOST:PORT``; replies go to whoever spoke last, or to
-    ``gcs`` (host, port) before anyone did.  Use as a context manager or call
+    """The vehicle, listening on UDP ``host:port`` (port 0 picks a free one; ground stations
+    connect with ``udpout:HOST:PORT``, replies go to whoever spoke last, or to ``gcs`` (host,
+    port) before anyone did), or on ``listen`` (``udp:HOST:PORT``, ``tcp:HOST:PORT``, ``pty``;
+    :attr:`connection` is how a ground station reaches it).  Use as a context manager or call
     :meth:`start` and :meth:`stop`."""
 
     def __init__(self, settings: VehicleSettings, port: int = 0, host: str = "127.0.0.1",
-                 gcs: tuple[str, int] | None = None) -> None:
+                 gcs: tuple[str, int] | None = None, listen: str | None = None) -> None:
         self.settings = settings
         self.frame = LocalFrame(settings.home.latitude_deg, settings.home.longitude_deg)
-        self._socket = socket.socket(socket.AF_INET, socket.SOCK_DGRAM)
-        self._socket.bind((host, port))
-        self._socket.settimeout(0.1)
-        self.host, self.port = self._socket.getsockname()
-        self._peer = gcs
+        self._transport: Transport = (open_transport(listen, gcs) if listen is not None
+                                      else UdpTransport(host, port, gcs))
+        self.host = getattr(self._transport, "host", "")
+        self.port = getattr(self._transport, "port", 0)
+        self.connection = self._transport.describe()
         # _lock: the flight and every call into MAVSDK from our threads.  _link_lock: the
         # pymavlink parser and encoder, used from MAVSDK's send callback, which therefore
         # never waits for _lock (MAVSDK's destroy joins that callback's thread).
@@ -109,10 +118,11 @@ class SimulatedVehicle:
         self._start_requested = False
         self._stop = threading.Event()
         self.finished = threading.Event()
-        self.mission: list[WireItem] = []     # the last mission the plugins accepted, as stored
-        self._stored = threading.Event()      # set while no accepted upload is pending
-        self._stored.set()
-        self.uploads = 0
+        home = stored_item(home_placeholder(settings.home), settings.autopilot)
+        self.store = MissionStore(settings.autopilot, settings.max_items, home)
+        self.server = MissionServer(self.store, self._emit, before_item=self._before_item,
+                                    on_stored=self._mission_stored,
+                                    upload_timeout_s=settings.upload_timeout_s)
         self.restarts = 0
         self.log = FlightLog()
         self.flight: MissionFlight | None = None
@@ -143,14 +153,32 @@ class SimulatedVehicle:
         self._stop.set()
         for thread in self._threads:
             thread.join(timeout=5)
+        with self._lock:                         # a reboot in progress boots no more
+            pass
         self._shutdown_mavsdk()
-        self._socket.close()
+        self._transport.close()
 
     def __enter__(self) -> "SimulatedVehicle":
         return self.start()
 
     def __exit__(self, *exc) -> None:
         self.stop()
+
+    @property
+    def mission(self) -> list[WireItem]:
+        """What the vehicle holds now, as it stores it: what a download returns and what it
+        flies (on ArduPilot, its home at seq 0 even without a mission)."""
+        return list(self.store.items)
+
+    @mission.setter
+    def mission(self, items: list[WireItem]) -> None:
+        with self._lock:
+            self.store.replace(items)
+
+    @property
+    def uploads(self) -> int:
+        """Uploads completed since the vehicle was created."""
+        return self.server.counts["uploads"]
 
     def _boot(self) -> None:
         from mavsdk import ComponentType, Configuration, Mavsdk
@@ -161,10 +189,11 @@ class SimulatedVehicle:
         mavsdk.add_any_connection("raw://")
         mavsdk.subscribe_raw_bytes_to_be_sent(self._from_mavsdk)
         server = mavsdk.server_component()
-        self._missions = MissionRawServer(server)
+        # Instantiated only so that MAVSDK announces MAV_PROTOCOL_CAPABILITY_MISSION_INT in
+        # AUTOPILOT_VERSION (MAVSDK ground stations refuse _INT transfers without it); every
+        # mission message is answered by self.server and never reaches this plugin.
+        self._mission_capability = MissionRawServer(server)
         self._telemetry = TelemetryServer(server)
-        self._missions.subscribe_incoming_mission(self._on_mission)
-        self._missions.subscribe_clear_all(lambda *_: self._set_mission([]))
         home = self.settings.home
         self._telemetry.publish_home(Position(home.latitude_deg, home.longitude_deg,
                                               home.altitude_amsl_m, 0.0))
@@ -178,25 +207,34 @@ class SimulatedVehicle:
             mavsdk.destroy()
 
     def restart(self) -> None:
-        """Reboot: silent for ``restart_s``, then up again without a mission."""
+        """Reboot: silent for ``restart_s``, then up again with what its storage kept (an
+        upload in progress is over; ArduPilot keeps the items it had written)."""
         self._restarting = True
         self.restarts += 1
         self._shutdown_mavsdk()
-        self.mission = []
-        time.sleep(self.settings.restart_s)
         with self._lock:
+            self.server.reset()
+        if self._stop.wait(self.settings.restart_s):
+            return                               # stopped while rebooting: stay down
+        with self._lock:
+            if self._stop.is_set():
+                return
             self._boot()
             self._restarting = False
 
     # -- the link ----------------------------------------------------------------------------
 
     def _send_datagram(self, data: bytes) -> None:
-        peer = self._peer
-        if peer is not None and not self._stop.is_set():
-            try:
-                self._socket.sendto(data, peer)
-            except OSError:
-                pass
+        if not self._stop.is_set():
+            self._transport.send(data)
+
+    def _emit(self, build) -> None:
+        """Send what ``build(encoder)`` encodes, from the autopilot (system 1, component 1)."""
+        if self._restarting:
+            return
+        with self._link_lock:
+            self._encoder.srcSystem, self._encoder.srcComponent = 1, 1
+            build(self._encoder)
 
     def _from_mavsdk(self, data: bytes) -> None:
         """Bytes MAVSDK sends: heartbeats become a fixed wing's; with signing, every message
@@ -234,14 +272,14 @@ class SimulatedVehicle:
     def _receive_loop(self) -> None:
         while not self._stop.is_set():
             try:
-                data, address = self._socket.recvfrom(65535)
-            except socket.timeout:
-                continue
-            except OSError:
+                data = self._transport.receive(0.05)
+            except (OSError, ValueError):
                 return
-            if self._restarting:
+            if not self._restarting:
+                with self._lock:
+                    self.server.update()
+            if data is None or self._restarting:
                 continue
-            self._peer = address
             with self._lock:
                 try:
                     messages = self._parser_in.parse_buffer(data) or []
@@ -253,6 +291,11 @@ class SimulatedVehicle:
             for message in messages:
                 if message.get_type() == "BAD_DATA":
                     continue       # a wrong signature, or no signature while signing: ignored
+                with self._lock:
+                    if self._restarting:
+                        break
+                    if self.server.handle(message):
+                        continue
                 if not self._handled_here(message):
                     with self._lock:
                         if self._mavsdk is not None and not self._restarting:
@@ -262,26 +305,6 @@ class SimulatedVehicle:
         """Answer what the plugins cannot; True when the message must not reach them."""
         kind = message.get_type()
         settings = self.settings
-        slots = settings.max_items if settings.max_items is not None else capacity(settings.autopilot)
-        if kind == "MISSION_COUNT" and message.mission_type == 0 and message.count > slots:
-            with self._link_lock:
-                self._encoder.srcSystem, self._encoder.srcComponent = 1, 1
-                self._encoder.statustext_send(
-                    MAV_SEVERITY_WARNING, f"Only {slots} items are supported".encode())
-                self._encoder.mission_ack_send(message.get_srcSystem(), message.get_srcComponent(),
-                                               MAV_MISSION_NO_SPACE, 0)
-            return True
-        if kind == "MISSION_COUNT" and message.mission_type == 0:
-            self._stored.clear()                # an upload begins: downloads wait for it
-        if kind in ("MISSION_REQUEST_LIST", "MISSION_REQUEST_INT", "MISSION_REQUEST", "MISSION_ACK") \
-                and getattr(message, "mission_type", 0) == 0:
-            self._serve_download(message)      # the vehicle's side of a download, from storage
-            return True
-        if kind == "MISSION_ITEM_INT" and settings.restart_at_item is not None \
-                and message.seq == settings.restart_at_item and not self._restart_done:
-            self._restart_done = True
-            threading.Thread(target=self.restart, daemon=True).start()
-            return True
         if kind == "PARAM_REQUEST_READ":
             self._answer_parameter(message)
             return True
@@ -324,51 +347,18 @@ class SimulatedVehicle:
 
     # -- the mission ---------------------------------------------------------------------------
 
-    def _serve_download(self, message) -> None:
-        """Answer a ground station's download from what the vehicle stored: the count for
-        MISSION_REQUEST_LIST, the item for either request form (any seq, any order, as often
-        as asked); its final MISSION_ACK needs no answer."""
-        kind = message.get_type()
-        if kind == "MISSION_ACK":
-            return
-        if kind == "MISSION_REQUEST_LIST":
-            # MAVSDK hands over an accepted upload after its final ACK: wait for it briefly.
-            self._stored.wait(1.0)
-        system, component = message.get_srcSystem(), message.get_srcComponent()
-        mission = list(self.mission)
-        with self._link_lock:
-            self._encoder.srcSystem, self._encoder.srcComponent = 1, 1
-            if kind == "MISSION_REQUEST_LIST":
-                self._encoder.mission_count_send(system, component, len(mission), 0)
-            elif 0 <= message.seq < len(mission):
-                i = mission[message.seq]
-                self._encoder.mission_item_int_send(
-                    system, component, i.seq, i.frame, i.command, 0, i.autocontinue, i.param1,
-                    i.param2, i.param3, i.param4, i.x, i.y, i.z, 0)
-            else:
-                self._encoder.mission_ack_send(system, component, MAV_MISSION_INVALID_SEQUENCE, 0)
+    def _before_item(self, seq: int) -> bool:
+        """Fault injection: reboot instead of storing item ``restart_at_item``."""
+        if seq == self.settings.restart_at_item and not self._restart_done:
+            self._restart_done = True
+            self._restarting = True
+            threading.Thread(target=self.restart, daemon=True).start()
+            return False
+        return True
 
-    def _with_own_home(self, items: list[WireItem]) -> list[WireItem]:
-        """ArduPilot keeps its own home at seq 0, whatever was sent there."""
-        if not items or first_mission_seq(self.settings.autopilot) == 0:
-            return items
-        return [home_placeholder(self.settings.home)] + items[1:]
-
-    def _set_mission(self, items: list[WireItem]) -> None:
-        self.mission = items
-        self._stored.set()
-
-    def _on_mission(self, result, plan, _user_data=None) -> None:
-        if getattr(result, "name", "") != "SUCCESS" or plan is None:
-            return
-        self.uploads += 1
-        # Kept as the autopilot stores it: what it flies is what a download would return.
-        self._set_mission(self._with_own_home([stored_item(WireItem.normalised(
-            i.seq, i.frame, i.command, 0, i.autocontinue, i.param1, i.param2, i.param3,
-            i.param4, i.x, i.y, i.z, i.mission_type), self.settings.autopilot)
-            for i in plan.mission_items]))
-        if self.settings.autostart:
-            self._start_requested = True     # the flight loop starts it, off MAVSDK's thread
+    def _mission_stored(self) -> None:
+        if self.settings.autostart and len(self.store.items) > first_mission_seq(self.settings.autopilot):
+            self._start_requested = True     # the flight loop starts it
 
     def local_items(self) -> list[LocalItem]:
         """The mission in the local frame (altitudes above home)."""
@@ -388,8 +378,6 @@ class SimulatedVehicle:
             self.log = FlightLog()
             self.finished.clear()
             self._completed = 0
-            if first:     # ArduPilot: home is item 0, never flown
-                self._missions.set_current_item_complete()
             self.flight = MissionFlight(items, self.settings.airframe, heading, first)
             return True
 
@@ -417,8 +405,9 @@ class SimulatedVehicle:
                 while self._completed < len(flight.reached):
                     self.log.reached.append(flight.reached[self._completed])
                     self._completed += 1
-                    if self._mavsdk is not None:
-                        self._missions.set_current_item_complete()
+                    seq = flight.reached[self._completed - 1][0]
+                    self._emit(lambda e, seq=seq: e.mission_item_reached_send(seq))
+                    self._emit(lambda e, seq=seq: e.mission_current_send(seq + 1))
                 if steps % publish_every == 0 or flight.finished:
                     self._publish(state)
                 if flight.finished:
@@ -430,13 +419,15 @@ class SimulatedVehicle:
                     time.sleep(ahead)
 
     def _publish(self, state) -> None:
-        from mavsdk.plugins.telemetry_server import Heading, Position, VelocityNed
-        if self._mavsdk is None:
-            return
+        """GLOBAL_POSITION_INT, from the vehicle's own encoder: in order with
+        MISSION_ITEM_REACHED (MAVSDK's telemetry server queues positions and, at a high
+        speed-up, delivers them after the mission's last item was reported)."""
         latitude, longitude = self.frame.to_geodetic(np.array([[state.x_m, state.y_m]]))
         speed = state.airspeed_m_s
-        self._telemetry.publish_position(
-            Position(float(latitude[0]), float(longitude[0]),
-                     self.settings.home.altitude_amsl_m + state.alt_m, state.alt_m),
-            VelocityNed(speed * math.sin(state.heading_rad), speed * math.cos(state.heading_rad), 0.0),
-            Heading(heading_to_bearing_deg(state.heading_rad)))
+        home = self.settings.home
+        bearing = heading_to_bearing_deg(state.heading_rad)
+        self._emit(lambda e: e.global_position_int_send(
+            int(state.time_s * 1000) & 0xFFFFFFFF, degrees_to_e7(float(latitude[0])),
+            degrees_to_e7(float(longitude[0])), round((home.altitude_amsl_m + state.alt_m) * 1000),
+            round(state.alt_m * 1000), round(100 * speed * math.sin(state.heading_rad)),
+            round(100 * speed * math.cos(state.heading_rad)), 0, round(bearing * 100) % 36000))

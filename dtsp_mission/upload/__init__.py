@@ -48,6 +48,8 @@ class UploadReport:
     verified: bool
     note: str = ""
     warnings: tuple[str, ...] = ()    # what the vehicle differs in from what the plan expects
+    fresh_starts: int = 0             # uploads started again with a new MISSION_COUNT
+    round_trip_s: float | None = None # the link's smoothed round trip, where measured
 
 
 #: A plan whose home is farther than this from the vehicle's is warned about.
@@ -94,7 +96,8 @@ def upload_mission(mission: VehicleMission, connection: str, via: str = "pymavli
                    verify: bool = True, signing_key: bytes | None = None,
                    progress: Progress | None = None,
                    heartbeat_timeout_s: float | None = None,
-                   designed_for: VehicleParameters | None = None) -> UploadReport:
+                   designed_for: VehicleParameters | None = None,
+                   timeout_s: float | None = None) -> UploadReport:
     """Upload ``mission`` and, with ``verify``, download it back and compare item by item.
 
     Before anything is sent, the vehicle's autopilot is checked against the plan's (a
@@ -102,11 +105,17 @@ def upload_mission(mission: VehicleMission, connection: str, via: str = "pymavli
     plan's (``designed_for``; differences become the report's ``warnings``).  Returns only
     when the vehicle accepted the mission (and, with ``verify``, holds what it can hold of
     it); otherwise raises :class:`LinkError` whose ``on_vehicle`` says what the vehicle holds.
+    ``timeout_s`` bounds each transfer (upload, verification download); default
+    :func:`~.base.transfer_timeout_s` of the mission's size.
     """
     uploader_class = get_uploader(via)
     if signing_key is not None and not uploader_class.supports_signing:
         raise InputError(f"the {via} uploader cannot sign MAVLink 2 messages; use --via pymavlink")
     options = {} if heartbeat_timeout_s is None else {"heartbeat_timeout_s": heartbeat_timeout_s}
+    if timeout_s is not None:
+        if not timeout_s > 0:
+            raise InputError(f"the transfer timeout must be above 0 s, got {timeout_s:g}")
+        options["timeout_s"] = timeout_s
     wire = to_wire(mission)
     if len(wire) > MAVLINK_MAX_ITEMS:
         raise InputError(f"the mission has {len(wire)} items (with the vehicle's home slot) but "
@@ -126,7 +135,8 @@ def upload_mission(mission: VehicleMission, connection: str, via: str = "pymavli
                                     uploader.resent, True,
                                     f"the transfer ended without an acknowledgement "
                                     f"({error.reason}), but the mission downloaded from the "
-                                    "vehicle is exactly the plan", warnings)
+                                    "vehicle is exactly the plan", warnings,
+                                    uploader.fresh_starts, _round_trip(uploader))
             what = (describe_vehicle(on_vehicle, wire, mission.autopilot) if verify else
                     "the vehicle may hold part of this mission (not checked: --no-verify)")
             raise LinkError(f"upload failed: {error.reason}", what) from None
@@ -143,7 +153,13 @@ def upload_mission(mission: VehicleMission, connection: str, via: str = "pymavli
                                 "from it differs from the plan: " + "; ".join(problems),
                                 describe_vehicle(on_vehicle, wire, mission.autopilot))
         return UploadReport(via, len(wire), time.perf_counter() - started, uploader.resent,
-                            verify, warnings=warnings)
+                            verify, warnings=warnings, fresh_starts=uploader.fresh_starts,
+                            round_trip_s=_round_trip(uploader))
+
+
+def _round_trip(uploader: Uploader) -> float | None:
+    timer = getattr(uploader, "_timer", None)
+    return getattr(timer, "srtt_s", None)
 
 
 def _download_or_none(uploader: Uploader) -> list[WireItem] | None:

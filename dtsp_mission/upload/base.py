@@ -12,14 +12,25 @@ from typing import Callable
 
 from .wire import WireItem
 
-#: ``progress(done, total)`` after every item that went out.
-Progress = Callable[[int, int], None]
+#: ``progress(done, total, resent)`` as a transfer advances: items through, items in all, and
+#: messages sent again so far (0 from an uploader that cannot tell).
+Progress = Callable[[int, int, int], None]
 
-#: Spec timings (MAVLink mission protocol, as QGroundControl uses them).
-TIMEOUT_S = 1.5          # for the first answer (count, list request, final ack)
-ITEM_TIMEOUT_S = 0.25    # between items
-RETRIES = 5
+#: The spec's mission-protocol timeout: the longest any retry waits.
+TIMEOUT_S = 1.5
+#: The shortest: retries wait the measured round trip plus four deviations, at least this.
+MIN_TIMEOUT_S = 0.005
+#: ArduPilot gives an upload up after 8 s without an item (MissionItemProtocol.h); quiet for
+#: longer than this, an uploader starts a fresh transfer.
+VEHICLE_GIVES_UP_S = 8.5
 HEARTBEAT_TIMEOUT_S = 5.0
+
+
+def transfer_timeout_s(items: int) -> float:
+    """The default bound on one upload or download of ``items`` items: 30 s plus 0.1 s per
+    item (a clean loopback transfer takes about 1 ms per item, a 57,600 baud telemetry radio
+    some 30-50 ms: the bound leaves room for a radio at the edge of its range)."""
+    return 30.0 + 0.1 * items
 
 
 @dataclass(frozen=True)
@@ -46,11 +57,15 @@ class Uploader:
     supports_signing: bool = False
 
     def __init__(self, connection: str, signing_key: bytes | None = None,
-                 heartbeat_timeout_s: float = HEARTBEAT_TIMEOUT_S) -> None:
+                 heartbeat_timeout_s: float = HEARTBEAT_TIMEOUT_S,
+                 timeout_s: float | None = None) -> None:
         self.connection = connection
         self.signing_key = signing_key
         self.heartbeat_timeout_s = heartbeat_timeout_s
-        self.resent = 0   # items, counts and requests sent again after a timeout
+        self.timeout_s = timeout_s   # per transfer; None: transfer_timeout_s(items)
+        self.resent = 0              # items, counts and requests sent again after a timeout
+        self.fresh_starts = 0        # uploads started again with a new MISSION_COUNT
+        self.stray_acks = 0          # acknowledgements that ended nothing (old, or repeats')
 
     def open(self) -> None:
         """Open the link and wait for the vehicle's heartbeat."""
@@ -68,7 +83,7 @@ class Uploader:
         """Send ``items`` (seq 0 first); returns when the vehicle accepted them."""
         raise NotImplementedError
 
-    def download(self) -> list[WireItem]:
+    def download(self, progress: Progress | None = None) -> list[WireItem]:
         """The mission the vehicle holds, seq 0 first."""
         raise NotImplementedError
 

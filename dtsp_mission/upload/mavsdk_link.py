@@ -78,7 +78,7 @@ class MavsdkUploader(Uploader):
         def report(result, data, _user_data) -> None:
             if result == MissionRawResult.NEXT:
                 if progress is not None and data.progress == data.progress:   # not NaN
-                    progress(round(data.progress * len(items)), len(items))
+                    progress(round(data.progress * len(items)), len(items), 0)
                 return
             outcome.append(result)
             finished.set()
@@ -90,7 +90,7 @@ class MavsdkUploader(Uploader):
         if outcome[0] != MissionRawResult.SUCCESS:
             raise _error(outcome[0])
 
-    def download(self) -> list[WireItem]:
+    def download(self, progress=None) -> list[WireItem]:
         from mavsdk.plugins.mission_raw import MissionRawError
         try:
             downloaded = self._mission_raw.download_mission()

@@ -18,7 +18,8 @@ from ..autopilot.parameters import parameter_name
 from ..errors import LinkError
 from ..mission import Command
 from .connection import check_host
-from .base import ITEM_TIMEOUT_S, RETRIES, TIMEOUT_S, Progress, Uploader, VehicleInfo
+from .base import (MIN_TIMEOUT_S, TIMEOUT_S, VEHICLE_GIVES_UP_S, Progress, Uploader, VehicleInfo,
+                   transfer_timeout_s)
 from .results import ITEM_RESULTS, NO_SPACE, result_text
 from .wire import MISSION_TYPE_MISSION, WireItem
 
@@ -26,6 +27,22 @@ GCS_SYSTEM_ID = 255
 GCS_COMPONENT_ID = 190          # MAV_COMP_ID_MISSIONPLANNER
 MAV_TYPE_GCS = 6
 MAV_AUTOPILOT_INVALID = 8
+MAV_AUTOPILOT_ARDUPILOTMEGA = 3
+MAV_MISSION_ERROR = 1
+MAV_MISSION_INVALID_SEQUENCE = 13
+MAV_MISSION_DENIED = 14
+MAV_MISSION_OPERATION_CANCELLED = 15
+#: A vehicle that never asks for an item in this long is not taking missions from us (it
+#: ignores our messages: unsigned to a signing vehicle, another system id ...).
+FIRST_ANSWER_S = 6.0
+#: At most this many items past the awaited one are repeated to ArduPilot after a timeout.
+PUSH_AHEAD = 8
+#: Requests a download keeps outstanding from ArduPilot (it serves any seq, in any order).
+DOWNLOAD_WINDOW = 8
+#: Fresh transfers (a new MISSION_COUNT) one upload may start before it gives up.
+MAX_FRESH_STARTS = 20
+#: Request timeouts in a row without any item before a download starts a new transfer.
+DOWNLOAD_RESTART_AFTER = 4
 HEARTBEAT_PERIOD_S = 1.0
 MAV_CMD_REQUEST_MESSAGE = 512
 MAVLINK_MSG_ID_HOME_POSITION = 242
@@ -100,8 +117,9 @@ class PymavlinkUploader(Uploader):
             if kind == "BAD_DATA":
                 if "signature" in str(getattr(message, "reason", "")).lower():
                     raw = bytes(getattr(message, "data", b"") or b"")
-                    if raw[:1] == b"\xfd" and len(raw) > 2 and not raw[2] & 0x01:
-                        self._unsigned += 1          # a MAVLink 2 message without signature
+                    if raw[:1] == b"\xfe" or (raw[:1] == b"\xfd" and len(raw) > 2
+                                               and not raw[2] & 0x01):
+                        self._unsigned += 1          # MAVLink 1, or MAVLink 2 without signature
                     else:
                         self._bad_signatures += 1
                 continue
@@ -123,7 +141,7 @@ class PymavlinkUploader(Uploader):
                 raw = bytes(message.get_msgbuf())
                 self._vehicle_signs = raw[:1] == b"\xfd" and bool(raw[2] & 0x01)   # signed flag
                 return
-        if self._unsigned and not self._bad_signatures:
+        if self._unsigned and self._unsigned >= self._bad_signatures:
             raise LinkError(f"the vehicle at {self.connection} answers, but it does not sign its "
                             "messages: upload without --signing-key, or set up MAVLink 2 signing "
                             "on the vehicle with this key first")
@@ -143,8 +161,7 @@ class PymavlinkUploader(Uploader):
         hint = ""
         if getattr(self, "_vehicle_signs", False) and self.signing_key is None:
             hint = ": the vehicle signs its messages and may ignore unsigned ones; give --signing-key"
-        return LinkError(f"the vehicle stopped answering ({what}; {RETRIES} retries, "
-                         f"timeouts {TIMEOUT_S:g} s / {ITEM_TIMEOUT_S:g} s){hint}")
+        return LinkError(f"the vehicle stopped answering ({what}){hint}")
 
     # -- what the vehicle is ---------------------------------------------------------------------
 
@@ -183,109 +200,280 @@ class PymavlinkUploader(Uploader):
             item.autocontinue, item.param1, item.param2, item.param3, item.param4, item.x,
             item.y, item.z, item.mission_type)
 
+    def _transfer_deadline(self, count: int) -> float:
+        return time.monotonic() + (self.timeout_s if self.timeout_s is not None
+                                   else transfer_timeout_s(count))
+
     def upload(self, items: list[WireItem], progress: Progress | None = None) -> None:
+        """Runs transfers until the vehicle acknowledges the whole mission or the deadline
+        passes: a fresh MISSION_COUNT whenever the vehicle gave up its side (it cancelled, or
+        said nothing for longer than it waits)."""
+        count = len(items)
+        deadline = self._transfer_deadline(count)
+        self._timer = getattr(self, "_timer", None) or RetransmitTimer()
+        self._ever_answered = False
+        attempts = 0
+        while True:
+            attempts += 1
+            outcome = self._upload_once(items, progress, deadline)
+            if outcome == "done":
+                return
+            self.fresh_starts += 1
+            if time.monotonic() >= deadline or attempts > MAX_FRESH_STARTS:
+                raise self._no_answer(f"{outcome}; {attempts} transfers started, the last one "
+                                      f"reached item {self._reached} of {count}, "
+                                      f"{time.monotonic() - deadline + self._budget(count):.0f} s in all")
+
+    def _budget(self, count: int) -> float:
+        return self.timeout_s if self.timeout_s is not None else transfer_timeout_s(count)
+
+    def _upload_once(self, items: list[WireItem], progress: Progress | None, deadline: float) -> str:
+        """One transfer: ``"done"``, or why a fresh one is needed.
+
+        The vehicle asks for each item and every request is answered at once.  When neither
+        a new request nor the final ACK comes within the retry timeout (the measured round
+        trip, not the vehicle's own 1 s re-request), the count (before any request) or the
+        awaited item goes out again -- and to ArduPilot, which writes any item whose seq is the
+        one it waits for, requested or not, also the items after it up to one beyond the
+        highest sent so far, since the lost messages may have been its requests for them.
+        (Sending ahead all the time was measured slower: on a link with jitter the items
+        overtake each other and ArduPilot drops those out of order.)"""
         system, component = self._target
         count = len(items)
-        self._link.mav.mission_count_send(system, component, count, MISSION_TYPE_MISSION)
-        highest = -1            # highest seq the vehicle asked for
-        retries = 0             # quiet periods of TIMEOUT_S without progress
-        quiet_since = time.monotonic()
+        timer = self._timer
+        ardupilot = self._autopilot == MAV_AUTOPILOT_ARDUPILOTMEGA
+        max_sent = -1
         kinds = {"MISSION_REQUEST_INT", "MISSION_REQUEST", "MISSION_ACK"}
-        while True:
-            # Wait in ITEM_TIMEOUT_S steps; after TIMEOUT_S of quiet send the count or the
-            # last item again (one retry).  Resending faster only restarts the vehicle's own
-            # request timer, which is what re-asks for a lost item.
-            message = self._receive(kinds, ITEM_TIMEOUT_S)
-            if message is None:
-                if time.monotonic() - quiet_since < TIMEOUT_S:
-                    continue
-                retries += 1
+        self._link.mav.mission_count_send(system, component, count, MISSION_TYPE_MISSION)
+        first_sent = {-1: time.monotonic()}   # seq -> first send (-1: the count)
+        last_sent: dict[int, float] = {}
+        resent: set[int] = set()              # Karn's rule: no round-trip sample from these
+        highest = -1                          # the highest seq the vehicle asked for
+        self._reached = 0
+        progress_at = time.monotonic()
+        retry_at = progress_at + timer.timeout_s   # stray answers do not put this off
+        answered = False                      # whether anything answered since the last retry
+
+        def send(seq: int, now: float) -> None:
+            nonlocal max_sent
+            if seq >= count:
+                return
+            max_sent = max(max_sent, seq)
+            if seq in last_sent:
+                resent.add(seq)
                 self.resent += 1
-                quiet_since = time.monotonic()
-                if retries > RETRIES:
-                    raise self._no_answer("no request for the first item" if highest < 0
-                                          else f"after item {highest} of {count}")
+            first_sent.setdefault(seq, now)
+            last_sent[seq] = now
+            self._send_item(items[seq])
+
+        while True:
+            now = time.monotonic()
+            if now >= deadline:
+                return "the time allowed ran out"
+            message = self._receive(kinds, max(0.0, min(retry_at, deadline) - now))
+            now = time.monotonic()
+            if message is None:
+                if now < retry_at:
+                    continue
+                if highest < 0 and not self._ever_answered and now - first_sent[-1] > FIRST_ANSWER_S:
+                    raise self._no_answer(f"no request for the first item in {FIRST_ANSWER_S:g} s")
+                if now - progress_at > VEHICLE_GIVES_UP_S:
+                    return "the vehicle went quiet"
+                if not answered:
+                    timer.back_off()            # nothing at all came back: the link is slower
+                answered = False
+                retry_at = now + timer.timeout_s
                 if highest < 0:
                     self._link.mav.mission_count_send(system, component, count, MISSION_TYPE_MISSION)
-                else:
-                    self._send_item(items[highest])
+                    resent.add(-1)
+                    self.resent += 1
+                    continue
+                last = min(max_sent + 1, highest + PUSH_AHEAD) if ardupilot else highest
+                for seq in range(highest, last + 1):
+                    send(seq, now)
                 continue
             if message.get_type() == "MISSION_ACK":
-                if message.type == 0:
-                    if highest == count - 1:
-                        return
-                    continue        # an old acknowledgement; this transfer is not done yet
-                raise self._rejection(message.type, items, highest, count)
+                result = message.type
+                if result == 0 and count - 1 in last_sent:
+                    if progress is not None:
+                        progress(count, count, self.resent)
+                    return "done"
+                if result in (0, MAV_MISSION_INVALID_SEQUENCE):
+                    self.stray_acks += 1        # an old ACCEPTED, or the answer to a copy
+                    answered = True
+                    continue
+                if result == MAV_MISSION_OPERATION_CANCELLED:
+                    return "the vehicle cancelled the transfer"
+                if result == MAV_MISSION_ERROR:
+                    if count - 1 in last_sent and highest >= count - PUSH_AHEAD:
+                        # The vehicle is done with this transfer and its ACCEPTED was lost:
+                        # upload_mission downloads the mission to see what arrived.
+                        raise LinkError("the vehicle's final acknowledgement was lost")
+                    if highest < 0:
+                        continue                # an answer to an item of an earlier transfer
+                    return "the vehicle was no longer in the transfer (MAV_MISSION_ERROR)"
+                raise self._rejection(result, items, highest, count)
             seq = message.seq
             if not 0 <= seq < count:
-                continue            # a request from another transfer
-            self._send_item(items[seq])
+                continue                        # a request from another transfer
+            self._ever_answered = True
             if seq > highest:
-                highest, retries, quiet_since = seq, 0, time.monotonic()
+                if seq - 1 not in resent and seq - 1 in first_sent:
+                    timer.sample(now - first_sent[seq - 1])
+                timer.settle()
+                highest, progress_at = seq, now
+                retry_at = now + timer.timeout_s
+                self._reached = seq
                 if progress is not None:
-                    progress(seq + 1, count)
+                    progress(seq, count, self.resent)
+            send(seq, now)
 
     def _rejection(self, result: int, items: list[WireItem], highest: int, count: int) -> LinkError:
         said = f" (the vehicle said: {' / '.join(self._status_texts)})" if self._status_texts else ""
         if result == NO_SPACE:
-            return LinkError(f"the vehicle has no room for {count} mission items "
+            return LinkError(f"the vehicle has no room for {count} mission slots "
                              f"({result_text(result)}){said}: lower --max-items and plan again")
         if result in ITEM_RESULTS and highest >= 0:
             item = items[highest]
             return LinkError(f"the vehicle rejected item {item.seq} ({_command_name(item.command)}"
                              f", frame {item.frame}): {result_text(result)}{said}")
+        if result == MAV_MISSION_DENIED:
+            return LinkError(f"the vehicle refused the mission: {result_text(result)}{said} "
+                             "(is another ground station uploading?)")
         return LinkError(f"the vehicle refused the mission: {result_text(result)}{said}")
 
-    def _request_list(self) -> int:
-        """Start a download transfer; the number of items the vehicle holds."""
+    def _request_list(self, deadline: float) -> int:
+        """Start a download transfer; the number of items the vehicle holds.  A vehicle still
+        busy with an upload (it DENIES downloads until it gives that up) is asked again."""
         system, component = self._target
-        for _ in range(RETRIES + 1):
+        timer = self._timer
+        started = answered = time.monotonic()
+        while (now := time.monotonic()) < deadline:
+            if now - answered > FIRST_ANSWER_S:
+                break
             self._link.mav.mission_request_list_send(system, component, MISSION_TYPE_MISSION)
-            message = self._receive({"MISSION_COUNT"}, TIMEOUT_S)
-            if message is not None:
+            asked = time.monotonic()
+            message = self._receive({"MISSION_COUNT", "MISSION_ACK"},
+                                    min(timer.timeout_s, max(0.0, deadline - asked)))
+            if message is not None and message.get_type() == "MISSION_COUNT":
+                timer.sample(time.monotonic() - asked)
                 return message.count
+            if message is not None:
+                answered = time.monotonic()
+                if message.type == MAV_MISSION_DENIED:   # busy with an upload: ask again later
+                    time.sleep(min(0.25, max(0.0, deadline - time.monotonic())))
             self.resent += 1
-        raise self._no_answer("no MISSION_COUNT for the download")
+            timer.back_off()
+        raise self._no_answer(f"no MISSION_COUNT for the download in {time.monotonic() - started:.0f} s")
 
-    def download(self) -> list[WireItem]:
-        """Requests items in order; when the vehicle stops serving one (a transfer it dropped
-        after lost or repeated messages), starts a new transfer and goes on from there."""
+    def download(self, progress: Progress | None = None) -> list[WireItem]:
+        """Asks for the missing items only -- to ArduPilot, which serves any seq, several at a
+        time; to others one at a time, in order -- each again after the retry timeout.  When
+        the vehicle stops serving an item (a transfer it dropped after lost or repeated
+        messages, or a vehicle that serves only in order and lost its place), starts a new
+        transfer from item 0.  Bounded by the transfer deadline."""
         system, component = self._target
-        count = self._request_list()
-        items: list[WireItem] = []
-        restarts = 0
+        self._timer = getattr(self, "_timer", None) or RetransmitTimer()
+        timer = self._timer
+        window = DOWNLOAD_WINDOW if self._autopilot == MAV_AUTOPILOT_ARDUPILOTMEGA else 1
+        started = time.monotonic()
+        count = self._request_list(started + self._budget(0))
+        deadline = started + self._budget(count)
+        items: dict[int, WireItem] = {}
+        asked: dict[int, float] = {}          # outstanding requests: seq -> last sent
+        tries: dict[int, int] = {}
+        restarts = cursor = quiet = 0         # quiet: expiries in a row without any item
+        kinds = {"MISSION_ITEM_INT", "MISSION_ITEM", "MISSION_COUNT"}
         while len(items) < count:
-            seq = len(items)
-            message = None
-            for _ in range(RETRIES + 1):
-                self._link.mav.mission_request_int_send(system, component, seq, MISSION_TYPE_MISSION)
-                message = self._receive_item(seq)
-                if message is not None:
-                    break
-                self.resent += 1
-            if message is None:
-                restarts += 1
-                if restarts > RETRIES:
-                    raise self._no_answer(f"no item {seq} of {count} in the download")
-                if self._request_list() != count:
+            now = time.monotonic()
+            if now >= deadline:
+                raise self._no_answer(f"the download got {len(items)} of {count} items in "
+                                      f"{now - started:.0f} s, {restarts} restarts")
+            while cursor in items:
+                cursor += 1
+            seq = cursor
+            while len(asked) < window and seq < count:       # fill the window
+                if seq not in items and seq not in asked:
+                    self._link.mav.mission_request_int_send(system, component, seq,
+                                                            MISSION_TYPE_MISSION)
+                    asked[seq] = now
+                    tries[seq] = tries.get(seq, 0) + 1
+                    if tries[seq] > 1:
+                        self.resent += 1
+                seq += 1
+            oldest = min(asked.values())
+            message = self._receive(kinds, max(0.0, min(oldest + timer.timeout_s, deadline) - now))
+            now = time.monotonic()
+            if message is None:                               # the oldest request expired
+                if now < oldest + timer.timeout_s:
+                    continue
+                timer.back_off()
+                quiet += 1
+                for late in [k for k, t in asked.items() if now - t >= timer.timeout_s / 2]:
+                    del asked[late]                   # asked again when the window refills
+                if quiet >= DOWNLOAD_RESTART_AFTER:
+                    # The vehicle stopped serving: a new transfer, and from item 0 for a
+                    # vehicle that serves only in order.
+                    restarts += 1
+                    quiet = 0
+                    if self._request_list(deadline) != count:
+                        raise LinkError("the vehicle's mission changed during the download")
+                    asked.clear()
+                    if window == 1:
+                        items.clear()
+                        cursor = 0
+                continue
+            if message.get_type() == "MISSION_COUNT":
+                if message.count != count:            # ArduPilot's answer to a seq beyond it
                     raise LinkError("the vehicle's mission changed during the download")
                 continue
-            restarts = 0
-            items.append(message)
+            got = message.seq
+            if got in items or not 0 <= got < count:
+                continue                              # a duplicate, or a stale answer
+            if got in asked and tries.get(got) == 1:
+                timer.sample(now - asked[got])
+            timer.settle()
+            quiet = 0
+            asked.pop(got, None)
+            items[got] = self._item_from(message)
+            if progress is not None:
+                progress(len(items), count, self.resent)
         self._link.mav.mission_ack_send(system, component, 0, MISSION_TYPE_MISSION)
-        return items
+        return [items[seq] for seq in range(count)]
 
-    def _receive_item(self, seq: int) -> WireItem | None:
-        deadline = time.monotonic() + ITEM_TIMEOUT_S
-        while (remaining := deadline - time.monotonic()) > 0:
-            message = self._receive({"MISSION_ITEM_INT", "MISSION_ITEM"}, remaining)
-            if message is None or message.seq != seq:
-                continue
-            x, y = message.x, message.y
-            if message.get_type() == "MISSION_ITEM":     # float degrees: the old message
-                x, y = round(x * 1e7), round(y * 1e7)
-            return WireItem.normalised(message.seq, message.frame, message.command,
-                                       message.current, message.autocontinue, message.param1,
-                                       message.param2, message.param3, message.param4, x, y,
-                                       message.z, MISSION_TYPE_MISSION)
-        return None
+    @staticmethod
+    def _item_from(message) -> WireItem:
+        x, y = message.x, message.y
+        if message.get_type() == "MISSION_ITEM":     # float degrees: the old message
+            x, y = round(x * 1e7), round(y * 1e7)
+        return WireItem.normalised(message.seq, message.frame, message.command, message.current,
+                                   message.autocontinue, message.param1, message.param2,
+                                   message.param3, message.param4, x, y, message.z,
+                                   MISSION_TYPE_MISSION)
+
+class RetransmitTimer:
+    """The retransmission timeout of a link, from its measured round trips (RFC 6298: smoothed
+    round trip plus four deviations, doubled per unanswered retry, never below
+    :data:`MIN_TIMEOUT_S` nor above the spec's :data:`TIMEOUT_S`)."""
+
+    def __init__(self) -> None:
+        self.srtt_s: float | None = None
+        self.rttvar_s = 0.0
+        self._base = TIMEOUT_S
+        self.timeout_s = TIMEOUT_S
+
+    def sample(self, rtt_s: float) -> None:
+        if self.srtt_s is None:
+            self.srtt_s, self.rttvar_s = rtt_s, rtt_s / 2
+        else:
+            self.rttvar_s = 0.75 * self.rttvar_s + 0.25 * abs(self.srtt_s - rtt_s)
+            self.srtt_s = 0.875 * self.srtt_s + 0.125 * rtt_s
+        self._base = min(TIMEOUT_S, max(MIN_TIMEOUT_S, self.srtt_s + 4 * self.rttvar_s))
+        self.timeout_s = self._base
+
+    def back_off(self) -> None:
+        self.timeout_s = min(TIMEOUT_S, 2 * self.timeout_s)
+
+    def settle(self) -> None:
+        """An answer came: back to the measured timeout."""
+        self.timeout_s = self._base

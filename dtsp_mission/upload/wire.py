@@ -90,23 +90,31 @@ def differences(planned: list[WireItem], on_vehicle: list[WireItem],
 
 def describe_vehicle(on_vehicle: list[WireItem] | None, planned: list[WireItem],
                      autopilot: Autopilot) -> str:
-    """One sentence on what the vehicle holds, for error messages."""
+    """One sentence on what the vehicle holds, for error messages: unknown, nothing, exactly
+    the plan, its earlier mission, the first k items of the plan (and what follows them), or
+    another mission."""
     if on_vehicle is None:
         return "what the vehicle holds now is unknown (downloading it failed too)"
-    real = len(on_vehicle) - min(len(on_vehicle), first_mission_seq(autopilot))
+    first = first_mission_seq(autopilot)
+    real = len(on_vehicle) - min(len(on_vehicle), first)
     if real == 0:
         return "the vehicle holds no mission now"
     if not differences(planned, on_vehicle, autopilot):
         return "the vehicle holds exactly the planned mission"
-    same = 0
-    for planned_item, vehicle_item in zip(planned, on_vehicle):
-        if planned_item.seq >= first_mission_seq(autopilot) and \
-                not holds(planned_item, vehicle_item, autopilot):
+    matching = 0
+    for planned_item, vehicle_item in zip(planned[first:], on_vehicle[first:]):
+        if not holds(planned_item, vehicle_item, autopilot):
             break
-        same += 1
-    matching = max(0, same - first_mission_seq(autopilot))
-    return (f"the vehicle now holds a different mission of {real} items ({matching} leading "
-            f"items match the plan): do not fly it")
+        matching += 1
+    total = len(planned) - first
+    if matching == 0:
+        return (f"the vehicle holds a mission of {real} items that shares nothing with this one "
+                "(its earlier mission, as far as this upload did not reach it): do not fly it "
+                "before uploading again")
+    rest = (f", followed by {real - matching} items left from its earlier mission"
+            if real > matching else "")
+    return (f"the vehicle holds the first {matching} of the {total} items of this mission{rest}: "
+            "do not fly it before uploading again")
 
 
 __all__ = ["COMPARED", "MISSION_TYPE_MISSION", "WireItem", "describe_vehicle", "differences",

@@ -20,7 +20,7 @@ def fly_offline(mission, airframe: Airframe):
         vehicle.mission = to_wire(mission.for_vehicle())
         items = vehicle.local_items()
     finally:
-        vehicle._socket.close()
+        vehicle._transport.close()
     ahead = next(i for i in items[first_mission_seq(mission.autopilot) + 1:] if i.command == 16)
     flight = MissionFlight(items, airframe, math.atan2(ahead.y_m, ahead.x_m),
                            first_mission_seq(mission.autopilot))

@@ -49,7 +49,15 @@ def test_differences_find_every_change_and_ignore_the_home_slot(mission):
     assert len(problems) == 1 and "item 5" in problems[0] and "y" in problems[0]
     assert "holds 7 items" in differences(wire, wire[:7], Autopilot.ARDUPILOTMEGA)[0]
     assert describe_vehicle(wire[:1], wire, Autopilot.ARDUPILOTMEGA) == "the vehicle holds no mission now"
-    assert "6 leading items match" in describe_vehicle(wire[:7], wire, Autopilot.ARDUPILOTMEGA)
+    real = len(wire) - 1
+    assert describe_vehicle(wire[:7], wire, Autopilot.ARDUPILOTMEGA).startswith(
+        f"the vehicle holds the first 6 of the {real} items of this mission: do not fly it")
+    # ArduPilot after a broken upload over a longer old mission: new items first, old ones after
+    old = [WireItem(**{**item.__dict__, "z": item.z + 7.0}) for item in wire]
+    assert f"the first 6 of the {real} items of this mission, followed by {real - 6} items left " \
+        "from its earlier mission" in describe_vehicle(wire[:7] + old[7:], wire, Autopilot.ARDUPILOTMEGA)
+    assert "shares nothing with this one (its earlier mission" in \
+        describe_vehicle(old[:9], wire, Autopilot.ARDUPILOTMEGA)
     assert "unknown" in describe_vehicle(None, wire, Autopilot.ARDUPILOTMEGA)
 
 
