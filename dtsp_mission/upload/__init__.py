@@ -50,6 +50,7 @@ class UploadReport:
     warnings: tuple[str, ...] = ()    # what the vehicle differs in from what the plan expects
     fresh_starts: int = 0             # uploads started again with a new MISSION_COUNT
     round_trip_s: float | None = None # the link's smoothed round trip, where measured
+    transfer_s: float = 0.0           # the upload and its verification, without connecting
 
 
 #: A plan whose home is farther than this from the vehicle's is warned about.
@@ -124,6 +125,7 @@ def upload_mission(mission: VehicleMission, connection: str, via: str = "pymavli
     with uploader_class(connection, signing_key=signing_key, **options) as uploader:
         names = NAMES if mission.autopilot == Autopilot.ARDUPILOTMEGA else ()
         warnings = tuple(vehicle_warnings(mission, uploader.vehicle_info(names), designed_for))
+        transfer_started = time.perf_counter()
         try:
             uploader.upload(wire, progress)
         except LinkError as error:
@@ -136,7 +138,8 @@ def upload_mission(mission: VehicleMission, connection: str, via: str = "pymavli
                                     f"the transfer ended without an acknowledgement "
                                     f"({error.reason}), but the mission downloaded from the "
                                     "vehicle is exactly the plan", warnings,
-                                    uploader.fresh_starts, _round_trip(uploader))
+                                    uploader.fresh_starts, _round_trip(uploader),
+                                    time.perf_counter() - transfer_started)
             what = (describe_vehicle(on_vehicle, wire, mission.autopilot) if verify else
                     "the vehicle may hold part of this mission (not checked: --no-verify)")
             raise LinkError(f"upload failed: {error.reason}", what) from None
@@ -154,7 +157,8 @@ def upload_mission(mission: VehicleMission, connection: str, via: str = "pymavli
                                 describe_vehicle(on_vehicle, wire, mission.autopilot))
         return UploadReport(via, len(wire), time.perf_counter() - started, uploader.resent,
                             verify, warnings=warnings, fresh_starts=uploader.fresh_starts,
-                            round_trip_s=_round_trip(uploader))
+                            round_trip_s=_round_trip(uploader),
+                            transfer_s=time.perf_counter() - transfer_started)
 
 
 def _round_trip(uploader: Uploader) -> float | None:

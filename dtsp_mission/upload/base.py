@@ -19,7 +19,7 @@ Progress = Callable[[int, int, int], None]
 #: The spec's mission-protocol timeout: the longest any retry waits.
 TIMEOUT_S = 1.5
 #: The shortest: retries wait the measured round trip plus four deviations, at least this.
-MIN_TIMEOUT_S = 0.005
+MIN_TIMEOUT_S = 0.003
 #: ArduPilot gives an upload up after 8 s without an item (MissionItemProtocol.h); quiet for
 #: longer than this, an uploader starts a fresh transfer.
 VEHICLE_GIVES_UP_S = 8.5

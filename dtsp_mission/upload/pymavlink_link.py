@@ -39,6 +39,8 @@ FIRST_ANSWER_S = 6.0
 PUSH_AHEAD = 8
 #: Requests a download keeps outstanding from ArduPilot (it serves any seq, in any order).
 DOWNLOAD_WINDOW = 8
+#: How long the vehicle is asked for its home and parameters before an upload.
+VEHICLE_INFO_S = 3.0
 #: Fresh transfers (a new MISSION_COUNT) one upload may start before it gives up.
 MAX_FRESH_STARTS = 20
 #: Request timeouts in a row without any item before a download starts a new transfer.
@@ -167,28 +169,45 @@ class PymavlinkUploader(Uploader):
 
     def vehicle_info(self, parameter_names: tuple[str, ...] = ()) -> VehicleInfo:
         """Its autopilot (heartbeat), home (HOME_POSITION, asked with MAV_CMD_REQUEST_MESSAGE)
-        and the named parameters (PARAM_REQUEST_READ, asked twice at most)."""
+        and the named parameters (PARAM_REQUEST_READ): what is still missing is asked again
+        every 0.1 s (or the measured retry timeout, once known; longer after a round without
+        any answer), for :data:`VEHICLE_INFO_S` at most (a vehicle stays
+        silent for a parameter it does not have).  The first answer measures the link's round
+        trip for the transfers that follow."""
         system, component = self._target
+        timer = self._timer = getattr(self, "_timer", None) or RetransmitTimer()
         values: dict[str, float] = {}
-        for _ in range(2):
-            missing = [n for n in parameter_names if n not in values]
-            if not missing:
+        home = None
+        started = time.monotonic()
+        deadline = started + VEHICLE_INFO_S
+        interval, rounds = 0.1, 0
+        while (missing := [n for n in parameter_names if n not in values]) or home is None:
+            now = time.monotonic()
+            if now >= deadline:
                 break
+            rounds += 1
             for name in missing:
                 self._link.mav.param_request_read_send(system, component, name.encode(), -1)
-            deadline = time.monotonic() + TIMEOUT_S
-            while (remaining := deadline - time.monotonic()) > 0 and len(values) < len(parameter_names):
-                message = self._receive({"PARAM_VALUE"}, remaining)
-                if message is not None:
-                    name = parameter_name(message.param_id)
-                    if name in parameter_names:
-                        values[name] = float(message.param_value)
-        home = None
-        self._link.mav.command_long_send(system, component, MAV_CMD_REQUEST_MESSAGE, 0,
-                                         MAVLINK_MSG_ID_HOME_POSITION, 0, 0, 0, 0, 0, 0)
-        message = self._receive({"HOME_POSITION"}, TIMEOUT_S)
-        if message is not None:
-            home = (message.latitude / 1e7, message.longitude / 1e7)
+            if home is None:
+                self._link.mav.command_long_send(system, component, MAV_CMD_REQUEST_MESSAGE, 0,
+                                                 MAVLINK_MSG_ID_HOME_POSITION, 0, 0, 0, 0, 0, 0)
+            until = min(deadline, now + interval)
+            answered = False
+            while (remaining := until - time.monotonic()) > 0:
+                message = self._receive({"PARAM_VALUE", "HOME_POSITION"}, remaining)
+                if message is None:
+                    continue
+                answered = True
+                if rounds == 1 and timer.srtt_s is None:
+                    timer.sample(time.monotonic() - now)
+                if message.get_type() == "HOME_POSITION":
+                    home = (message.latitude / 1e7, message.longitude / 1e7)
+                elif (name := parameter_name(message.param_id)) in parameter_names:
+                    values[name] = float(message.param_value)
+                if home is not None and len(values) == len(parameter_names):
+                    break
+            interval = (min(1.0, interval * 2) if not answered else
+                        max(0.05, 2 * timer.timeout_s) if timer.srtt_s is not None else 0.1)
         return VehicleInfo(self._autopilot, home, values, True)
 
     # -- the mission protocol ------------------------------------------------------------------
