@@ -59,6 +59,18 @@ def test_upload_command_errors(mission, tmp_path, start_vehicle):
     assert result.exit_code == 2 and "not a valid QGroundControl plan" in result.output
     result = run("upload", tmp_path / "m.geojson", "--connect", "udpout:127.0.0.1:1")
     assert result.exit_code == 2
+    # the home slot is counted the same way in every line: slots, never "items" for one, and
+    # "items" for the other
+    slots = len(to_wire(mission.for_vehicle()))
+    result = run("upload", path, "--connect", f"udpout:127.0.0.1:{vehicle.port}")
+    assert f"({slots} mission slots)" in result.output and f"no room for {slots} mission slots" in result.output
+    for link in ("/dev/ttyNOSUCH0,57600", "COM3,57600", "tcp:127.0.0.1:1"):     # nothing there
+        result = run("upload", path, "--connect", link, "--heartbeat-timeout", "1")
+        errors = [line for line in result.output.splitlines() if line.startswith("Error")]
+        assert result.exit_code == 2 and len(errors) == 1 and "cannot open the connection" in errors[0] \
+            and "Traceback" not in result.output, result.output
+    result = run("upload", path, "--connect", f"udpout:127.0.0.1:{vehicle.port}", "--timeout", "0")
+    assert result.exit_code == 2 and "timeout must be above 0 s" in result.output
 
 
 def test_fly_command_reports_every_target(mission, tmp_path):
@@ -158,3 +170,20 @@ def test_a_site_too_big_for_the_vehicle_is_flown_as_sorties_it_accepts(tmp_path,
         assert "simulated flight completed" in result.output
         flown += len(re.findall(r"^item \d+\t([\d.]+)\t", result.output, re.M))
     assert flown == 272                     # every target in exactly one sortie, each flown
+
+
+def test_upload_and_fly_print_one_json_summary(mission, tmp_path, start_vehicle):
+    import json
+    path = tmp_path / "m.plan"
+    exporter_for(path).write(mission, path)
+    vehicle = start_vehicle(mission)
+    result = CliRunner().invoke(cli, ["upload", str(path), "--connect", f"udpout:127.0.0.1:{vehicle.port}",
+                                      "--json", "-q"], catch_exceptions=False)
+    assert result.exit_code == 0 and result.stderr == ""
+    upload = json.loads(result.stdout)["upload"]
+    assert upload["verified"] and upload["mission_slots"] == len(to_wire(mission.for_vehicle()))
+    result = CliRunner().invoke(cli, ["fly", str(path), "--radius", "80", "--airspeed", "20",
+                                      "--speedup", "400", "--json"], catch_exceptions=False)
+    flight = json.loads(result.stdout)["flight"]
+    assert result.exit_code == 0 and flight["completed"] and len(flight["targets"]) == 8
+    assert "simulated flight completed" in result.stderr

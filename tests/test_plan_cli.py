@@ -159,3 +159,24 @@ def test_the_plot_is_written_in_the_format_of_its_extension(tmp_path, suffix, ma
 def test_an_unknown_plot_format_is_refused_before_planning(tmp_path):
     result = run(str(EXAMPLE), "--radius", "80", "--plot", str(tmp_path / "m.gif"))
     assert result.returncode == 2 and ".gif is none of them" in result.stderr
+
+
+def test_quiet_prints_nothing_and_json_prints_one_summary(tmp_path):
+    """-q: no output but errors; --json: exactly one JSON object on stdout (the report lines
+    on stderr), with the lengths, items and files a script needs; -q --json: only that."""
+    import json
+    targets = tmp_path / "t.csv"
+    targets.write_text("lat,lon\n46.80,6.94\n46.81,6.95\n46.805,6.955\n46.79,6.96\n")
+    out = tmp_path / "m.plan"
+    quiet = run(targets, "--radius", 80, "-q", "-o", out, "--time-limit", 0)
+    assert quiet.returncode == 0 and quiet.stdout == "" and quiet.stderr == "" and out.exists()
+    loud = run(targets, "--radius", 80, "--json", "-o", out, "--airspeed", 22, "--time-limit", 0)
+    summary = json.loads(loud.stdout)
+    assert summary["targets"] == 4 and summary["files"] == [str(out)]
+    assert summary["tour_length_m"] > 0 and summary["flight_length_m"] > 0 and summary["items"] > 4
+    assert len(summary["predicted_miss_m"]) == 4 and "planner auto" in loud.stderr
+    both = run(targets, "--radius", 80, "--json", "-q", "-o", out, "--airspeed", 22, "--time-limit", 0)
+    assert both.stderr == "" and summary["flight_time_s"] > 0
+    assert {**json.loads(both.stdout), "planning_s": 0} == {**summary, "planning_s": 0}
+    failed = run(targets, "--radius", -1, "-q")
+    assert failed.returncode == 2 and failed.stdout == "" and "Error" in failed.stderr

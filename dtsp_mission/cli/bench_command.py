@@ -109,12 +109,14 @@ def planners_bench(sizes, seeds, rho_m, side_m, names, families, anchor, time_li
         family_list = list(dict.fromkeys(r.family for r in runs))
         seeds = len({r.seed for r in runs})
     else:
-        with click.progressbar(length=steps, label="planning", file=sys.stderr,
-                               item_show_func=lambda step: step) as bar:
-            def progress(step: str) -> None:
-                bar.update(1, step)
-            runs = planner_bench.run(sizes, seeds, rho_m, side_m, chosen, progress, family_list,
-                                     time_limit_s)
+        if sys.stderr.isatty():
+            with click.progressbar(length=steps, label="planning", file=sys.stderr,
+                                   item_show_func=lambda step: step) as bar:
+                runs = planner_bench.run(sizes, seeds, rho_m, side_m, chosen,
+                                         lambda step: bar.update(1, step), family_list, time_limit_s)
+        else:       # no bar fragments in a log file
+            runs = planner_bench.run(sizes, seeds, rho_m, side_m, chosen, lambda step: None,
+                                     family_list, time_limit_s)
     click.echo(f"families {', '.join(family_list)} (uniform and clustered in a {side_m:g} m "
                f"square), rho {rho_m:g} m, {seeds} seeds; medians over seeds")
     click.echo(planner_bench.table(runs))

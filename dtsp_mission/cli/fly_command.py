@@ -7,6 +7,8 @@ import click
 import numpy as np
 
 from ..sim.fly import FlightCheck, fly_mission, targets_in
+from . import console
+from .console import console_options, record, say
 from .options import apply, progress_reporter, reports_errors, simulation_options, vehicle_options
 from .sim_command import airframe_from
 
@@ -32,18 +34,25 @@ def run_flight_check(mission, targets, airframe, via: str, speedup: float,
 def print_check(check: FlightCheck) -> None:
     minutes = check.flight_time_s / 60
     state = "completed" if check.completed else "NOT completed"
-    click.echo(f"simulated flight {state}: {check.items_reached} of {check.items} items, "
+    record(flight={"completed": check.completed, "items_reached": check.items_reached,
+                   "items": check.items, "flight_time_s": check.flight_time_s,
+                   "min_turn_radius_m": check.min_turn_radius_m, "position_reports": check.samples,
+                   "targets": [{"name": name, "miss_m": miss, "altitude_error_m": altitude}
+                               for name, miss, altitude in zip(check.names, check.miss_m,
+                                                               check.altitude_error_m)],
+                   "max_miss_m": check.max_miss_m})
+    say(f"simulated flight {state}: {check.items_reached} of {check.items} items, "
                f"{minutes:.1f} min of flight (L1 period {check.airframe.l1_period_s:g} s, "
                f"min turn radius {check.airframe.min_turn_radius_m:g} m)")
-    click.echo(f"uploaded via {check.upload.via} in {check.upload.seconds:.2f} s; "
+    say(f"uploaded via {check.upload.via} in {check.upload.seconds:.2f} s; "
                f"{check.samples} position reports received")
-    click.echo(f"smallest turn radius in the telemetry: {check.min_turn_radius_m:.1f} m")
+    say(f"smallest turn radius in the telemetry: {check.min_turn_radius_m:.1f} m")
     if len(check.miss_m):
-        click.echo(f"targets passed within: median {np.median(check.miss_m):.2f} m, max "
+        say(f"targets passed within: median {np.median(check.miss_m):.2f} m, max "
                    f"{check.max_miss_m:.2f} m")
-        click.echo("target\tmiss_m\taltitude_error_m")
+        say("target\tmiss_m\taltitude_error_m")
         for name, miss, altitude in zip(check.names, check.miss_m, check.altitude_error_m):
-            click.echo(f"{name}\t{miss:.2f}\t{altitude:+.1f}")
+            say(f"{name}\t{miss:.2f}\t{altitude:+.1f}")
 
 
 @click.command()
@@ -56,9 +65,10 @@ def print_check(check: FlightCheck) -> None:
               help="Exit with status 1 if any target is missed by more than this.")
 @click.option("--max-items", type=int, metavar="N", help="Mission slots of the simulated "
               "vehicle (default: a stock vehicle's, ArduPlane 655, PX4 500).")
+@apply(console_options)
 @reports_errors
 def fly(mission_file, rho_m, airspeed_m_s, max_bank_deg, speedup, vehicle_params_file,
-        l1_period_s, via, format_name, max_miss_m, max_items) -> None:
+        l1_period_s, via, format_name, max_miss_m, max_items, quiet, as_json) -> None:
     """Upload MISSION_FILE to the simulated fixed wing, fly it, and print per-target miss
     distances and the flight time.
 
@@ -69,7 +79,11 @@ def fly(mission_file, rho_m, airspeed_m_s, max_bank_deg, speedup, vehicle_params
     Example: dtsp-mission fly mission.plan --radius 80 --airspeed 22
     """
     from ..export import read_mission
+    console.start(quiet, as_json)
     mission = read_mission(mission_file, format_name)
     airframe, _, _ = airframe_from(vehicle_params_file, airspeed_m_s, max_bank_deg, l1_period_s,
                                    rho_m)
-    run_flight_check(mission, targets_in(mission), airframe, via, speedup, max_miss_m, max_items)
+    try:
+        run_flight_check(mission, targets_in(mission), airframe, via, speedup, max_miss_m, max_items)
+    finally:
+        console.finish()       # the summary also when --max-miss fails the check

@@ -25,6 +25,8 @@ from ..planning.rbta import region_heading_deg
 from ..plot import draw_plan, plot_format, require_matplotlib
 from ..targets import GeoTargets, Targets, random_targets, read_targets
 from ..targets.geojson_file import read_geojson
+from . import console
+from .console import console_options, note, record, say
 from .options import (LAT_LON, UserError, apply, link_options, mission_options,
                       mission_settings, progress_reporter, reports_errors, seed_option, simulation_options,
                       turn_radius_from, vehicle_options)
@@ -136,13 +138,14 @@ def _duration(seconds: float) -> str:
 @click.option("--simulate", is_flag=True, help="Fly the mission in the simulator (an ArduPlane "
               "with --vehicle-params, stock without) and print per-target miss distances.")
 @apply(simulation_options)
+@apply(console_options)
 @reports_errors
 def plan(targets_file, random_count, area_file, seed, origin, rho_m, airspeed_m_s, max_bank_deg,
          altitude_m, home_deg, home_amsl_m, launch_bearing_deg, landing_bearing_deg, autopilot,
          return_mode, design, max_miss_m, tolerance_m, max_items, algorithm, region, time_limit_s,
          fallback, outputs, format_name,
          plot_file, connection, via, verify, signing_key_file, transfer_timeout_s, simulate, speedup,
-         vehicle_params_file, l1_period_s) -> None:
+         vehicle_params_file, l1_period_s, quiet, as_json) -> None:
     """Plan a Dubins tour through the targets and write it as a mission.
 
     TARGETS_FILE: CSV with lat,lon columns (optional alt, name), or local x,y metres (with
@@ -150,6 +153,7 @@ def plan(targets_file, random_count, area_file, seed, origin, rho_m, airspeed_m_
 
     Example: dtsp-mission plan examples/site-inspection.csv --radius 80 --alt 120 -o mission.plan
     """
+    console.start(quiet, as_json)
     writers = [(output, exporter_for(output, format_name)) for output in outputs]
     if plot_file:
         require_matplotlib()
@@ -171,15 +175,15 @@ def plan(targets_file, random_count, area_file, seed, origin, rho_m, airspeed_m_
         raise UserError(f"{needs_mission[0]}: a mission needs targets in degrees; these are "
                         "local x/y metres, so give --origin LAT,LON (or write only a .json tour)")
     if local.merged_duplicates:
-        click.echo(f"note: {local.merged_duplicates} duplicate targets merged "
-                   f"({len(local)} remain)", err=True)
+        note(f"{local.merged_duplicates} duplicate targets merged ({len(local)} remain)")
     area_m = None
     if geodetic is not None and geodetic.area_deg is not None:
         area_m = frame.to_local(geodetic.area_deg[:, 0], geodetic.area_deg[:, 1])
         outside = int((~shapely.contains_xy(shapely.Polygon(area_m), *local.positions_m.T)).sum())
         if outside:
-            click.echo(f"note: {outside} targets lie outside the survey area", err=True)
-    click.echo(f"{len(local)} targets; {rho_source}")
+            note(f"{outside} targets lie outside the survey area")
+    say(f"{len(local)} targets; {rho_source}")
+    record(targets=len(local), rho_m=rho)
 
     parameters = {"region": region} if algorithm in ("rbta", "auto") else {}
     if algorithm == "auto":
@@ -194,7 +198,7 @@ def plan(targets_file, random_count, area_file, seed, origin, rho_m, airspeed_m_
     except TilingUnavailable as error:
         if not fallback:
             raise
-        click.echo(f"note: {error}; planning with the Alternating Algorithm instead", err=True)
+        note(f"{error}; planning with the Alternating Algorithm instead")
         tour = get_planner("alternating").plan(local.positions_m, rho)
     finally:
         close_progress()
@@ -213,7 +217,7 @@ def plan(targets_file, random_count, area_file, seed, origin, rho_m, airspeed_m_
         except MissionTooLarge as error:
             if not (any(writer.needs_mission for _, writer in writers) or connection or simulate):
                 # Only the tour is asked for: the vehicle's storage does not limit it.
-                click.echo(f"note: as one mission this would not fit the vehicle: {error}", err=True)
+                note(f"as one mission this would not fit the vehicle: {error}")
             else:
                 sorties = _split(tour, frame, geodetic, settings, error)
         if isinstance(product, Mission) and "predicted_miss_m" in product.summary:
@@ -221,16 +225,16 @@ def plan(targets_file, random_count, area_file, seed, origin, rho_m, airspeed_m_
             widened = with_turn_margin(product, lambda r: planner.plan(local.positions_m, r),
                                        geodetic, settings)
             if widened is not product:
-                click.echo(f"note: planned with a turn radius of {widened.rho_m:g} m instead of "
+                note(f"planned with a turn radius of {widened.rho_m:g} m instead of "
                            f"{rho:g} m so that the autopilot's guidance can hold the turns: "
                            f"{targets_beyond(product, max_miss_m)} -> "
                            f"{targets_beyond(widened, max_miss_m)} targets predicted beyond "
-                           "--max-miss", err=True)
+                           "--max-miss")
                 product, tour = widened, widened.tour
         if isinstance(product, Mission):
             _report_mission(product)
     elif airspeed_m_s:
-        click.echo(f"flight time of the tour at {airspeed_m_s:g} m/s: "
+        say(f"flight time of the tour at {airspeed_m_s:g} m/s: "
                    f"{_duration(tour.length_m / airspeed_m_s)}")
     if sorties and connection:
         raise UserError(f"the mission is split into {len(sorties)} sorties (one file each); "
@@ -246,10 +250,12 @@ def plan(targets_file, random_count, area_file, seed, origin, rho_m, airspeed_m_
             rendered.append((output, writer, writer.render_for(product, output, frame)))
     for output, writer, content in rendered:
         write_atomic(output, content)
-        click.echo(f"wrote {output} ({writer.description})")
+        say(f"wrote {output} ({writer.description})")
+        console.current().summary.setdefault("files", []).append(str(output))
     if plot_file:
         draw_plan(product, plot_file, area_m)
-        click.echo(f"wrote {plot_file} (plot)")
+        say(f"wrote {plot_file} (plot)")
+        record(plot=str(plot_file))
     if (connection or simulate) and frame is None:
         raise UserError("--upload and --simulate need a mission in degrees: targets in lat/lon, "
                         "or local x/y with --origin")
@@ -260,14 +266,16 @@ def plan(targets_file, random_count, area_file, seed, origin, rho_m, airspeed_m_
         airframe, _, _ = airframe_from(vehicle_params_file, airspeed_m_s, None, l1_period_s)
         for k, flown in enumerate([s.mission for s in sorties] or [product]):
             if sorties:
-                click.echo(f"sortie {k + 1} of {len(sorties)}:")
-            run_flight_check(flown.for_vehicle(), planned_targets(flown), airframe, via, speedup,
-                             max_miss_m, max_items)
+                say(f"sortie {k + 1} of {len(sorties)}:")
+            run_flight_check(flown.for_vehicle(), planned_targets(flown), airframe, via,
+                             speedup, max_miss_m, max_items)
+            console.current().summary.setdefault("simulated", []).append(console.current().summary.pop("flight"))
     if connection:
         from .upload_command import run_upload
         run_upload(product.for_vehicle(), connection, via, verify, signing_key_file,
                    designed_for=_designed_for(vehicle_params_file),
                    transfer_timeout_s=transfer_timeout_s)
+    console.finish()
 
 
 def _split(tour, frame, geodetic, settings, error):
@@ -275,7 +283,10 @@ def _split(tour, frame, geodetic, settings, error):
     home_m = (frame.to_local(*settings.home_deg)[0] if settings.home_deg is not None
               else np.zeros(2))
     sorties = split_into_sorties(tour, frame, geodetic, settings, home_m)
-    click.echo(f"as one mission it needs {error.needed} items (at least) but the vehicle holds "
+    record(sorties=[{"targets": len(s.targets), "items": s.mission.summary["items"],
+                     "flight_length_m": s.mission.summary["flight_length_m"],
+                     "flight_time_s": s.mission.summary.get("flight_time_s")} for s in sorties])
+    say(f"as one mission it needs {error.needed} items (at least) but the vehicle holds "
                f"{error.capacity} (--max-items): split into {len(sorties)} sorties, each a "
                "take-off, a contiguous part of the tour and the return, balanced by flight time:")
     names = geodetic.names
@@ -287,7 +298,7 @@ def _split(tour, frame, geodetic, settings, error):
                      else "")
         beyond = targets_beyond(sortie.mission, settings.max_miss_m) \
             if "predicted_miss_m" in summary else 0
-        click.echo(f"  sortie {k + 1}: {len(sortie.targets)} targets ({label(first)} .. "
+        say(f"  sortie {k + 1}: {len(sortie.targets)} targets ({label(first)} .. "
                    f"{label(last)}), {summary['items']} items, "
                    f"{summary['flight_length_m'] / 1e3:,.2f} km{time_text}"
                    + (f", {beyond} predicted beyond --max-miss" if beyond else ""))
@@ -308,30 +319,32 @@ def _report_tour(tour, positions: np.ndarray, area_m: np.ndarray | None, elapsed
     else:
         area = max(float(np.ptp(positions[:, 0]) * np.ptp(positions[:, 1])), 1.0)
     bound = lower_bound(positions, tour.rho_m, area)
-    click.echo(f"planner {tour.planner}: tour {tour.length_m:,.1f} m ({elapsed:.2f} s)")
+    say(f"planner {tour.planner}: tour {tour.length_m:,.1f} m ({elapsed:.2f} s)")
+    record(planner=tour.planner, tour_length_m=tour.length_m, planning_s=elapsed,
+           lower_bound_m=bound.one_tree_m)
     if tour.report.get("merged_targets"):
-        click.echo(f"note: {tour.report['merged_targets']} targets lie within "
-                   f"{MERGE_RESOLUTION_RHO:g} rho of another and are visited as one", err=True)
-    click.echo(f"  certified lower bound (1-tree) {bound.one_tree_m:,.1f} m: ratio "
+        note(f"{tour.report['merged_targets']} targets lie within "
+                   f"{MERGE_RESOLUTION_RHO:g} rho of another and are visited as one")
+    say(f"  certified lower bound (1-tree) {bound.one_tree_m:,.1f} m: ratio "
                f"{tour.length_m / bound.one_tree_m:.3f}; estimate for uniform targets "
                f"{bound.stochastic_m:,.1f} m: ratio {tour.length_m / bound.stochastic_m:.3f}")
     for phase in tour.report.get("phases", []):
-        click.echo(f"  phase {phase['phase']}: meta-beads of {phase['meta_bead_beads'][0]}x"
+        say(f"  phase {phase['phase']}: meta-beads of {phase['meta_bead_beads'][0]}x"
                    f"{phase['meta_bead_beads'][1]} beads, {phase['serviced']} targets, "
                    f"{phase['length_m']:,.1f} m")
     for name, result in tour.report.get("candidates", {}).items():
         shown = f"{result:,.1f} m" if isinstance(result, float) else result
-        click.echo(f"  candidate {name}: {shown}")
+        say(f"  candidate {name}: {shown}")
     improvement = tour.report.get("improvement")
     if improvement:
         gain = 1.0 - improvement["length_m"] / improvement["start_m"]
         spent = improvement["evaluations"] / max(improvement["budget"], 1)
-        click.echo(f"  improvement: {improvement['start_m']:,.1f} m -> {improvement['length_m']:,.1f} m "
+        say(f"  improvement: {improvement['start_m']:,.1f} m -> {improvement['length_m']:,.1f} m "
                    f"({100 * gain:.1f} % shorter; {improvement['kicks']} perturbations, "
                    f"{100 * min(spent, 1.0):.0f} % of the --time-limit budget, "
                    f"{'stopped by the budget' if improvement['stopped'] == 'budget' else improvement['stopped']})")
     if "leftovers" in tour.report:
-        click.echo(f"  leftovers (Alternating Algorithm): {tour.report['leftovers']} targets, "
+        say(f"  leftovers (Alternating Algorithm): {tour.report['leftovers']} targets, "
                    f"{tour.report['leftover_length_m']:,.1f} m")
 
 
@@ -340,21 +353,26 @@ def _report_mission(mission) -> None:
     flavour = "ArduPilot" if mission.autopilot == Autopilot.ARDUPILOTMEGA else "PX4"
     if "predicted_miss_m" in summary:
         misses = np.asarray(summary["predicted_miss_m"])
-        click.echo(f"mission ({flavour}): {summary['items']} items ({summary['items'] / len(misses):.2f} "
+        say(f"mission ({flavour}): {summary['items']} items ({summary['items'] / len(misses):.2f} "
                    f"per target, {summary['shaping_waypoints']} shaping waypoints), "
                    f"{summary['vehicle_slots']} vehicle slots; designed for the autopilot's "
                    f"guidance: targets passed within median {np.median(misses):.1f} m, max "
                    f"{misses.max():.1f} m in the flight model")
-        click.echo(f"  predicted flight {summary['predicted_flight_m'] / 1e3:,.2f} km against "
+        say(f"  predicted flight {summary['predicted_flight_m'] / 1e3:,.2f} km against "
                    f"{summary['planned_flight_m'] / 1e3:,.2f} km of exact path (take-off to the "
                    "last target)")
     else:
-        click.echo(f"mission ({flavour}): {summary['items']} items, {summary['vehicle_slots']} "
+        say(f"mission ({flavour}): {summary['items']} items, {summary['vehicle_slots']} "
                    f"vehicle slots; waypoints within {mission.tolerance_m:.2f} m of the exact path")
+    record(autopilot=flavour, items=summary["items"], mission_slots=summary["vehicle_slots"],
+           flight_length_m=summary["flight_length_m"], flight_time_s=summary.get("flight_time_s"))
+    if "predicted_miss_m" in summary:
+        record(predicted_miss_m=summary["predicted_miss_m"],
+               predicted_flight_m=summary["predicted_flight_m"])
     line = f"flight: {summary['flight_length_m'] / 1e3:,.2f} km from take-off to the return"
     if "flight_time_s" in summary:
         line += f", {_duration(summary['flight_time_s'])} at {mission.cruise_speed_m_s:g} m/s"
-    click.echo(line)
-    for note in mission.notes:
-        click.echo(f"note: {note}", err=True)
+    say(line)
+    for text in mission.notes:
+        note(text)
 

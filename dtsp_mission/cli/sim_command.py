@@ -52,11 +52,13 @@ def airframe_from(vehicle_params_file, airspeed_m_s, max_bank_deg, l1_period_s,
 
 
 @click.command()
-@click.option("--listen", default="127.0.0.1:14550", show_default=True, metavar="LINK",
+@click.option("--listen", default="tcp:127.0.0.1:5760", show_default=True, metavar="LINK",
               help="Where the vehicle listens: HOST:PORT or udp:HOST:PORT (ground stations "
                    "connect with udpout:HOST:PORT), tcp:HOST:PORT (as ArduPilot SITL's "
                    "tcp:127.0.0.1:5760), or pty (a pseudo-terminal: ground stations open the "
-                   "printed device as a serial port).")
+                   "printed device as a serial port).  The default is ArduPilot SITL's, so a "
+                   "ground station's SITL link works unchanged; UDP 14550 is QGroundControl's own "
+                   "port and cannot be shared with it.")
 @click.option("--gcs", metavar="HOST:PORT", help="Also send to a ground station listening here "
               "(QGroundControl listens on 127.0.0.1:14550) before it speaks.")
 @click.option("--home", "home_deg", type=LAT_LON, required=True, help="Where the vehicle stands.")
@@ -80,6 +82,7 @@ def sim(listen, gcs, home_deg, home_amsl_m, autopilot, rho_m, airspeed_m_s, max_
     """Run a simulated fixed-wing vehicle that accepts missions over MAVLink and flies them.
 
     Example: dtsp-mission sim --home 46.805,6.941 --radius 80 --airspeed 22 --autostart
+    (then: dtsp-mission upload mission.plan --connect tcp:127.0.0.1:5760)
     """
     airframe, parameters, source = airframe_from(vehicle_params_file, airspeed_m_s, max_bank_deg,
                                                  l1_period_s, rho_m)

@@ -6,6 +6,8 @@ import click
 
 from ..upload import to_wire, upload_mission
 from ..upload.connection import read_signing_key
+from . import console
+from .console import console_options, note, record, say
 from .options import (UserError, apply, link_options, mission_options, mission_settings,
                       progress_reporter, reports_errors, vehicle_options)
 
@@ -18,7 +20,7 @@ def run_upload(mission, connection: str, via: str, verify: bool, signing_key_fil
     progress, close = progress_reporter("uploading")
     slots = len(to_wire(mission))
     home = " and the home slot" if slots > len(mission.items) else ""
-    click.echo(f"uploading {len(mission.items)} mission items{home} ({slots} mission slots) to "
+    say(f"uploading {len(mission.items)} mission items{home} ({slots} mission slots) to "
                f"{connection} via {via}")
     try:
         report = upload_mission(mission, connection, via=via, verify=verify, signing_key=key,
@@ -27,14 +29,18 @@ def run_upload(mission, connection: str, via: str, verify: bool, signing_key_fil
     finally:
         close()
     for warning in report.warnings:
-        click.echo(f"warning: {warning}", err=True)
+        note(f"warning: {warning}")
     fresh = f", {report.fresh_starts} fresh starts" if report.fresh_starts else ""
     line = (f"the vehicle accepted {report.items} mission slots in {report.seconds:.2f} s "
             f"({report.resent} messages resent{fresh})")
-    click.echo(line + ("; downloaded back: it holds exactly the planned mission" if report.verified
+    say(line + ("; downloaded back: it holds exactly the planned mission" if report.verified
                        else "; not verified (--no-verify)"))
     if report.note:
-        click.echo(f"note: {report.note}", err=True)
+        note(report.note)
+    record(upload={"via": report.via, "mission_slots": report.items, "seconds": report.seconds,
+                   "transfer_s": report.transfer_s, "resent": report.resent,
+                   "fresh_starts": report.fresh_starts, "verified": report.verified,
+                   "round_trip_s": report.round_trip_s})
 
 
 @click.command()
@@ -52,9 +58,11 @@ def run_upload(mission, connection: str, via: str, verify: bool, signing_key_fil
               metavar="FILE.parm", help="The parameters the mission was designed for; each "
               "navigation parameter the vehicle has otherwise is warned about (default: a "
               "stock ArduPlane's).")
+@apply(console_options)
 @reports_errors
 def upload(mission_file, connection, via, verify, signing_key_file, transfer_timeout_s,
-           format_name, heartbeat_timeout_s, vehicle_params_file, **mission_option_values) -> None:
+           format_name, heartbeat_timeout_s, vehicle_params_file, quiet, as_json,
+           **mission_option_values) -> None:
     """Upload MISSION_FILE (.plan, .waypoints, or a tour .json) to a vehicle over MAVLink.
 
     A tour .json (from `plan -o tour.json`, with its frame origin) becomes a mission here,
@@ -75,6 +83,7 @@ def upload(mission_file, connection, via, verify, signing_key_file, transfer_tim
     Example: dtsp-mission upload mission.plan --connect udpout:127.0.0.1:14550
     """
     from ..export import exporter_for, read_mission
+    console.start(quiet, as_json)
     if exporter_for(mission_file, format_name).name == "tour":
         mission = _tour_mission(mission_file, mission_settings(**mission_option_values))
     else:
@@ -82,6 +91,7 @@ def upload(mission_file, connection, via, verify, signing_key_file, transfer_tim
     from .plan_command import _designed_for
     run_upload(mission, connection, via, verify, signing_key_file, heartbeat_timeout_s,
                _designed_for(vehicle_params_file), transfer_timeout_s)
+    console.finish()
 
 
 def _tour_mission(path, settings):
@@ -102,5 +112,5 @@ def _tour_mission(path, settings):
     frame = LocalFrame(*origin)
     targets = local_targets(tour.targets_m).to_geodetic(frame)
     mission = build_mission(tour, frame, targets, settings)
-    click.echo(f"mission from the tour: {len(mission.items)} items")
+    say(f"mission from the tour: {len(mission.items)} items")
     return mission.for_vehicle()
