@@ -12,6 +12,7 @@ def test_planner_bench_measures_every_planner_and_auto_is_shortest(tmp_path):
          "--markdown", str(tmp_path / "table.md"), "--plot", str(tmp_path / "plot.png")],
         capture_output=True, text=True, timeout=600)
     assert result.returncode == 0, result.stderr
+    assert "planning" not in result.stderr      # no progress-bar label in a log (not a terminal)
     runs = json.loads((tmp_path / "runs.json").read_text())
     assert {r["planner"] for r in runs} >= {"alternating", "headings", "rbta", "auto"}
     assert len(runs) == 2 * 2 * len({r["planner"] for r in runs})

@@ -58,3 +58,21 @@ def test_a_broken_plugin_is_reported_and_the_cli_still_works(tmp_path):
     assert works.returncode == 0 and "word LSL" in works.stdout
     broken = run("exploding", env=env)
     assert broken.returncode != 0 and "could not be loaded" in broken.stderr
+
+
+def test_every_command_has_help_with_an_example():
+    """The user guide promises it: every command and subcommand shows an example in --help."""
+    import click
+    from click.testing import CliRunner
+
+    from dtsp_mission.cli.main import cli
+
+    def commands(group, path):
+        for name, command in group.commands.items():
+            yield [*path, name]
+            if isinstance(command, click.Group):
+                yield from commands(command, [*path, name])
+
+    missing = [" ".join(path) for path in commands(cli, [])
+               if "Example" not in CliRunner().invoke(cli, [*path, "--help"]).output]
+    assert not missing, f"no example in --help of: {missing}"

@@ -180,3 +180,25 @@ def test_quiet_prints_nothing_and_json_prints_one_summary(tmp_path):
     assert {**json.loads(both.stdout), "planning_s": 0} == {**summary, "planning_s": 0}
     failed = run(targets, "--radius", -1, "-q")
     assert failed.returncode == 2 and failed.stdout == "" and "Error" in failed.stderr
+
+
+def test_a_first_run_says_that_it_compiles(tmp_path):
+    """Without numba's cache the first plan compiles for about a minute: it says so first
+    (run here with the JIT off, so nothing is compiled or cached); with the cache, silence."""
+    import os
+    targets = tmp_path / "t.csv"
+    targets.write_text("lat,lon\n46.80,6.94\n46.81,6.95\n46.805,6.955\n")
+    base = [sys.executable, "-m", "dtsp_mission.cli", "plan", str(targets), "--radius", "80",
+            "--algorithm", "alternating"]
+    cold = tmp_path / "cold"
+    cold.mkdir()
+    env = {**os.environ, "NUMBA_CACHE_DIR": str(cold), "NUMBA_DISABLE_JIT": "1"}
+    first = subprocess.run(base, capture_output=True, text=True, timeout=300, env=env)
+    assert first.returncode == 0, first.stderr
+    assert "first run on this machine: compiling the planning kernels" in first.stderr
+    warm = tmp_path / "warm" / "dtsp_mission" / "planning"
+    warm.mkdir(parents=True)
+    (warm / "improve._descend-1.py311.nbi").write_bytes(b"")
+    env["NUMBA_CACHE_DIR"] = str(tmp_path / "warm")
+    again = subprocess.run(base, capture_output=True, text=True, timeout=300, env=env)
+    assert again.returncode == 0 and "compiling" not in again.stderr

@@ -13,7 +13,10 @@ bench_radius_option = click.option("--radius", "rho_m", type=float, default=100.
 
 @click.group()
 def bench() -> None:
-    """Measure speed and memory; results are printed as tables."""
+    """Measure speed and memory; results are printed as tables.
+
+    Example: dtsp-mission bench planners --sizes 100,400 --seeds 2
+    """
 
 
 @bench.command("dubins")
@@ -29,7 +32,10 @@ def bench() -> None:
 @reports_errors
 def dubins_bench(pairs: int, ompl_pairs: int, rho_m: float, half_width_m: float, repeats: int,
                  seed: int) -> None:
-    """Batch Dubins lengths per second, beside OMPL called per pair from Python."""
+    """Batch Dubins lengths per second, beside OMPL called per pair from Python.
+
+    Example: dtsp-mission bench dubins --pairs 1000000
+    """
     from ..bench import dubins_throughput
     rows, difference = dubins_throughput.run(pairs, ompl_pairs, rho_m, half_width_m, repeats, seed)
     click.echo(dubins_throughput.report(rows, difference))
@@ -79,7 +85,10 @@ def planners_bench(sizes, seeds, rho_m, side_m, names, families, anchor, time_li
                    csv_file, json_file, markdown_file, plot_file) -> None:
     """Every planner on seeded instances of each family: length, ratio to the lower bound, to
     the best of the run and (--anchor) to the LKH-3 anchor, time, peak memory, checker
-    verdict (medians over seeds)."""
+    verdict (medians over seeds).
+
+    Example: dtsp-mission bench planners --sizes 50,200 --families uniform,dense --seeds 2
+    """
     import sys
 
     from ..bench import planners as planner_bench

@@ -188,6 +188,10 @@ def plan(targets_file, random_count, area_file, seed, origin, rho_m, airspeed_m_
     parameters = {"region": region} if algorithm in ("rbta", "auto") else {}
     if algorithm == "auto":
         parameters.update(time_limit_s=time_limit_s, seed=seed)
+    from ..compiled import kernels_cached
+    if not kernels_cached():
+        note("first run on this machine: compiling the planning kernels (about a minute, "
+             "once; later runs start at once)")
     started = time.perf_counter()
     progress, close_progress = progress_reporter("improving the tour")
     try:

@@ -46,7 +46,10 @@ def inventory() -> list[dict[str, str]]:
 def plugins(as_json: bool) -> None:
     """List installed planners, exporters, uploaders and commands, built-in or third-party, with
     the distribution that provides each; broken plugins are listed with the reason (and skipped
-    everywhere else)."""
+    everywhere else).
+
+    Example: dtsp-mission plugins
+    """
     records = inventory()
     if as_json:
         click.echo(json.dumps(records, indent=2))
