@@ -41,8 +41,11 @@ def geojson_dict(mission: Mission) -> dict:
     latitudes, longitudes = mission.target_positions_deg
     for target, item_index in enumerate(item_of_target):
         item = mission.items[item_index]
-        properties = {"kind": "target", "target": target, "visit": int(rank[target]),
-                      "item": item_index, "altitude_m": item.altitude_m,
+        # Numbers as the user sees them elsewhere: the target's 1-based row in the targets
+        # file, its 1-based place in the visiting order, its mission item as QGroundControl
+        # numbers it (1-based; home is 0).
+        properties = {"kind": "target", "target": target + 1, "visit": int(rank[target]) + 1,
+                      "item": item_index + 1, "altitude_m": item.altitude_m,
                       "s_m": float(path.target_s_m[target])}
         if mission.target_names is not None:
             properties["name"] = mission.target_names[target]
@@ -50,7 +53,7 @@ def geojson_dict(mission: Mission) -> dict:
     for index, item in enumerate(mission.items):
         if item.has_position:
             features.append(_point(item.latitude_deg, item.longitude_deg,
-                                   {"kind": "waypoint", "item": index, "command": int(item.command),
+                                   {"kind": "waypoint", "item": index + 1, "command": int(item.command),
                                     "role": item.role, "altitude_m": item.altitude_m}))
     return {"type": "FeatureCollection", "features": features}
 

@@ -54,7 +54,7 @@ def targets_in(mission: VehicleMission, names: tuple[str, ...] | None = None) ->
     NAV_WAYPOINT with an acceptance radius (how dtsp-mission writes targets)."""
     chosen = [item for item in mission.items if item.role == "target"]
     if chosen:
-        labels = tuple(names[i.target] if names else f"target {i.target}" for i in chosen)
+        labels = tuple(names[i.target] if names else f"target {i.target + 1}" for i in chosen)
     else:
         numbered = [(seq, item) for seq, item in enumerate(mission.items, start=1)
                     if item.command == Command.NAV_WAYPOINT and item.params[1] > 0]

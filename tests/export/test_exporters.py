@@ -136,9 +136,9 @@ def test_geojson_has_path_targets_waypoints_and_home(mission, tmp_path):
     assert np.hypot(*(local[0] - mission.path.chain.starts[0, :2])) < 1e-6
     for feature in features:
         if feature["properties"]["kind"] == "target":
-            target = feature["properties"]["target"]
+            target = feature["properties"]["target"] - 1          # numbers are 1-based
             assert feature["properties"]["name"] == f"t{target}"
-            item = mission.items[feature["properties"]["item"]]
+            item = mission.items[feature["properties"]["item"] - 1]
             assert item.role == "target" and item.target == target
             assert feature["geometry"]["coordinates"] == [item.longitude_deg, item.latitude_deg]
 
@@ -156,3 +156,27 @@ def test_mission_formats_refuse_a_bare_tour(mission, tmp_path):
         exporter_for("m.plan").write(mission.tour, tmp_path / "m.plan")
     assert not (tmp_path / "m.plan").exists()
     assert mission.items[0].command == Command.NAV_TAKEOFF
+
+
+def test_targets_are_numbered_alike_in_every_output(mission, tmp_path):
+    """Target N is the file's row N (1-based) in GeoJSON, KML and fly's report; visits count
+    from 1; a mission item has the number QGroundControl shows (1-based, home is 0)."""
+    from dataclasses import replace as replaced
+
+    from dtsp_mission.sim.fly import targets_in
+    path = exporter_for("m.geojson").write(mission, tmp_path / "m.geojson")
+    targets = [f["properties"] for f in json.loads(path.read_text())["features"]
+               if f["properties"]["kind"] == "target"]
+    count = len(mission.target_items)
+    assert sorted(t["target"] for t in targets) == list(range(1, count + 1))
+    assert sorted(t["visit"] for t in targets) == list(range(1, count + 1))
+    for t in targets:
+        assert mission.items[t["item"] - 1].target == t["target"] - 1
+    unnamed = replaced(mission, target_names=None)
+    labels = targets_in(unnamed).names
+    assert sorted(labels, key=lambda label: int(label.split()[1])) == \
+        [f"target {k}" for k in range(1, count + 1)]
+    kml = pytest.importorskip("dtsp_mission_kml")
+    text = exporter_for("m.kml").render_for(unnamed, tmp_path / "m.kml")
+    text = text.decode() if isinstance(text, bytes) else text
+    assert "<name>target 1</name>" in text and "<name>T0</name>" not in text and kml

@@ -90,10 +90,11 @@ def kml_document(mission: Mission) -> ET.Element:
     latitudes, longitudes = mission.target_positions_deg
     for target, item_index in enumerate(mission.target_items):
         item = mission.items[item_index]
-        name = mission.target_names[target] if mission.target_names is not None else f"T{target}"
+        name = (mission.target_names[target] if mission.target_names is not None
+                else f"target {target + 1}")
         _point(target_folder, name,
-               f"visit {visit_rank[target] + 1} of {len(visit_rank)}; overfly at "
-               f"{item.altitude_m:g} m above home; mission item {item_index}",
+               f"target {target + 1}, visit {visit_rank[target] + 1} of {len(visit_rank)}; "
+               f"overfly at {item.altitude_m:g} m above home; mission item {item_index + 1}",
                "#target", latitudes[target], longitudes[target])
 
     home_folder = ET.SubElement(document, "Folder")
