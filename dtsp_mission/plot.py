@@ -59,8 +59,10 @@ def draw_plan(product: Mission | Tour, path: str | os.PathLike,
         ring = np.vstack([area_m, area_m[:1]])
         axes.fill(ring[:, 0], ring[:, 1], color="#e8f0e0", zorder=0, label="survey area")
     axes.plot(line[:, 0], line[:, 1], color="#1f5fa8", linewidth=0.8,
-              label=f"flight path ({chain.length_m / 1e3:,.1f} km)" if mission
-              else f"tour ({tour.length_m / 1e3:,.1f} km)", zorder=2)
+              # the two lengths plan reports, named and rounded as it prints them
+              label=f"flight: {mission.summary['flight_length_m'] / 1e3:,.2f} km from take-off "
+                    f"to the return (tour {tour.length_m:,.1f} m)" if mission
+              else f"tour {tour.length_m:,.1f} m", zorder=2)
     if mission:
         frame = mission.frame
         positioned = [item for item in mission.items

@@ -29,7 +29,10 @@ def geojson_dict(mission: Mission) -> dict:
         "type": "Feature",
         "geometry": {"type": "LineString",
                      "coordinates": np.column_stack([longitudes, latitudes]).tolist()},
+        # length_m: this line (take-off's end to the last target); flight_length_m: what plan
+        # reports as the flight (take-off to the return); tour_length_m: the closed tour.
         "properties": {"kind": "flight_path", "length_m": path.chain.length_m,
+                       "flight_length_m": mission.summary["flight_length_m"],
                        "rho_m": mission.rho_m, "tour_length_m": mission.tour.length_m,
                        "planner": mission.tour.planner},
     }]

@@ -180,3 +180,18 @@ def test_targets_are_numbered_alike_in_every_output(mission, tmp_path):
     text = exporter_for("m.kml").render_for(unnamed, tmp_path / "m.kml")
     text = text.decode() if isinstance(text, bytes) else text
     assert "<name>target 1</name>" in text and "<name>T0</name>" not in text and kml
+
+
+def test_every_output_gives_the_same_two_lengths(mission, tmp_path):
+    """One flight length (take-off to the return) and one tour length (the closed Dubins
+    tour), named and rounded as plan prints them, in GeoJSON and KML alike."""
+    flight_km = f"{mission.summary['flight_length_m'] / 1e3:,.2f} km"
+    tour_m = f"tour {mission.tour.length_m:,.1f} m"
+    path = exporter_for("m.geojson").write(mission, tmp_path / "m.geojson")
+    line = json.loads(path.read_text())["features"][0]["properties"]
+    assert line["flight_length_m"] == mission.summary["flight_length_m"]
+    assert line["tour_length_m"] == mission.tour.length_m
+    pytest.importorskip("dtsp_mission_kml")
+    text = exporter_for("m.kml").render_for(mission, tmp_path / "m.kml")
+    text = text.decode() if isinstance(text, bytes) else text
+    assert f"flight: {flight_km} from take-off to the return ({tour_m}" in text

@@ -67,8 +67,9 @@ def kml_document(mission: Mission) -> ET.Element:
     tour = mission.tour
     _text(document, "name", f"dtsp-mission: {len(tour.targets_m)} targets, {tour.planner}")
     _text(document, "description",
-          f"Dubins tour of {mission.path.chain.length_m:,.0f} m for turn radius "
-          f"{mission.rho_m:g} m; {len(mission.items)} mission items; altitudes are above home.")
+          f"flight: {mission.summary['flight_length_m'] / 1e3:,.2f} km from take-off to the "
+          f"return (tour {tour.length_m:,.1f} m: the closed Dubins tour for turn radius "
+          f"{mission.rho_m:g} m); {len(mission.items)} mission items; altitudes are above home.")
     _style(document, "path", PATH_COLOUR, 3.0)
     _style(document, "target", TARGET_COLOUR, None)
     _style(document, "home", "ffffffff", None)
