@@ -90,3 +90,20 @@ def test_random_targets_are_inside_uniform_and_seeded():
     assert abs(west - 0.5) < 0.03
     with pytest.raises(InputError):
         random_targets(area, 0, seed=1)
+
+
+def test_the_api_refuses_bad_geotargets_with_its_own_words():
+    """Not pyproj's 'Invalid latitude' or 'must be same size' from deep inside the planner."""
+    import numpy as np
+    import pytest
+
+    from dtsp_mission.errors import InputError
+    from dtsp_mission.targets import GeoTargets
+    with pytest.raises(InputError, match=r"target 1: latitude 91.0 is not a number of degrees between -90 and 90"):
+        GeoTargets(np.array([91.0, 46.0]), np.array([6.9, 6.91]))
+    with pytest.raises(InputError, match="one latitude and one longitude per target: got 3 latitudes and 2"):
+        GeoTargets(np.array([46.0, 46.1, 46.2]), np.array([6.9, 6.91]))
+    with pytest.raises(InputError, match="target 2: longitude nan"):
+        GeoTargets([46.0, 46.1], [6.9, float("nan")])
+    with pytest.raises(InputError, match="2 targets but 1 names"):
+        GeoTargets([46.0, 46.1], [6.9, 6.91], ("a",))

@@ -81,14 +81,14 @@ class MissionSettings:
                              f"({rho_m:g} m), got {tolerance!r}")
         max_items = DEFAULT_MAX_ITEMS[self.autopilot] if self.max_items is None else self.max_items
         if max_items < 1:
-            raise InputError(f"--max-items must be at least 1, got {max_items}")
+            raise InputError(f"max_items (--max-items) must be at least 1, got {max_items}")
         if max_items > MAVLINK_MAX_ITEMS:
-            raise InputError(f"--max-items {max_items} is more than MAVLink can address: a "
+            raise InputError(f"max_items (--max-items) {max_items} is more than MAVLink can address: a "
                              f"mission has at most {MAVLINK_MAX_ITEMS} items (16-bit sequence numbers)")
         if self.design not in DESIGNS:
             raise InputError(f"unknown waypoint design {self.design!r}; choose {', '.join(DESIGNS)}")
         if not (math.isfinite(self.max_miss_m) and self.max_miss_m > 0):
-            raise InputError(f"--max-miss must be a number above 0 m, got {self.max_miss_m!r}")
+            raise InputError(f"max_miss_m (--max-miss) must be a number above 0 m, got {self.max_miss_m!r}")
         if not (math.isfinite(self.home_altitude_amsl_m) and abs(self.home_altitude_amsl_m) < 1e4):
             raise InputError(f"home altitude must be a number of metres above sea level, got "
                              f"{self.home_altitude_amsl_m!r}")

@@ -51,6 +51,27 @@ class GeoTargets:
     altitudes_m: np.ndarray | None = None
     area_deg: np.ndarray | None = None
 
+    def __post_init__(self) -> None:
+        """Raise :class:`InputError` (a message for a caller of the API, naming no command-line
+        option) unless the coordinates are equally long 1-D arrays of finite WGS84 degrees and
+        names and altitudes, where given, have one entry per target."""
+        latitudes = np.asarray(self.latitudes_deg, dtype=float)
+        longitudes = np.asarray(self.longitudes_deg, dtype=float)
+        if latitudes.ndim != 1 or longitudes.ndim != 1 or len(latitudes) != len(longitudes):
+            raise InputError(f"GeoTargets needs one latitude and one longitude per target: got "
+                             f"{latitudes.size} latitudes and {longitudes.size} longitudes")
+        for name, values, limit in (("latitude", latitudes, 90.0), ("longitude", longitudes, 180.0)):
+            bad = ~np.isfinite(values) | (np.abs(values) > limit)
+            if bad.any():
+                index = int(np.argmax(bad))
+                raise InputError(f"target {index + 1}: {name} {float(values[index])!r} is not a "
+                                 f"number of degrees between -{limit:g} and {limit:g}")
+        for label, values in (("names", self.names), ("altitudes", self.altitudes_m)):
+            if values is not None and len(values) != len(latitudes):
+                raise InputError(f"GeoTargets has {len(latitudes)} targets but {len(values)} {label}")
+        object.__setattr__(self, "latitudes_deg", latitudes)
+        object.__setattr__(self, "longitudes_deg", longitudes)
+
     def __len__(self) -> int:
         return len(self.latitudes_deg)
 

@@ -15,7 +15,7 @@ def random_targets(area_deg: np.ndarray, count: int, seed: int) -> GeoTargets:
     the polygon ``area_deg`` ((k, 2) rows of latitude, longitude).  The same seed gives the same
     targets."""
     if count < 1:
-        raise InputError(f"--random needs at least 1 target, got {count}")
+        raise InputError(f"random targets: the count (--random) must be at least 1, got {count}")
     area = np.asarray(area_deg, dtype=float)
     frame = LocalFrame.around(area[:, 0], area[:, 1], "survey area vertices")
     polygon = shapely.Polygon(frame.to_local(area[:, 0], area[:, 1]))
