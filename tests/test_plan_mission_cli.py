@@ -148,3 +148,30 @@ def test_a_tour_only_output_never_fails_on_the_mission_budget(tmp_path):
     assert "as one mission this would not fit the vehicle" in result.stderr
     tour = json.loads(out.read_text())
     assert "origin" in json.dumps(tour) and len(tour["targets"]) == 272
+
+
+def test_a_site_across_the_antimeridian_gives_a_geojson_line_cut_there(tmp_path):
+    """RFC 7946 3.1.9: the flight path is a MultiLineString whose parts meet at +-180 deg;
+    no segment jumps across the map."""
+    import json
+    import subprocess
+    import sys
+
+    import shapely.geometry
+    targets = tmp_path / "fiji.csv"
+    targets.write_text("lat,lon\n-16.50,179.990\n-16.51,-179.995\n-16.505,179.985\n-16.49,-179.99\n")
+    out = tmp_path / "m.geojson"
+    result = subprocess.run([sys.executable, "-m", "dtsp_mission.cli", "plan", str(targets),
+                             "--radius", "80", "-o", str(out), "--time-limit", "0"],
+                            capture_output=True, text=True, timeout=300)
+    assert result.returncode == 0, result.stderr
+    geometry = json.loads(out.read_text())["features"][0]["geometry"]
+    assert geometry["type"] == "MultiLineString" and len(geometry["coordinates"]) >= 2
+    line = shapely.geometry.shape(geometry)
+    for part in geometry["coordinates"]:
+        longitudes = [p[0] for p in part]
+        assert max(abs(a - b) for a, b in zip(longitudes, longitudes[1:])) < 1.0
+    ends = [part[-1] for part in geometry["coordinates"][:-1]]
+    starts = [part[0] for part in geometry["coordinates"][1:]]
+    assert all(abs(e[0]) == 180.0 and s[0] == -e[0] and s[1] == e[1] for e, s in zip(ends, starts))
+    assert line.is_valid

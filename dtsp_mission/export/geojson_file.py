@@ -21,14 +21,36 @@ def _point(latitude: float, longitude: float, properties: dict) -> dict:
             "properties": properties}
 
 
+def line_geometry(latitudes: np.ndarray, longitudes: np.ndarray) -> dict:
+    """A LineString, or -- for a line that crosses the antimeridian -- a MultiLineString cut
+    there, each part ending on +-180 degrees at the interpolated crossing (RFC 7946, 3.1.9)."""
+    longitudes = np.asarray(longitudes, dtype=float)
+    latitudes = np.asarray(latitudes, dtype=float)
+    jumps = np.flatnonzero(np.abs(np.diff(longitudes)) > 180.0)
+    if not len(jumps):
+        return {"type": "LineString", "coordinates": np.column_stack([longitudes, latitudes]).tolist()}
+    parts, current = [], [[longitudes[0], latitudes[0]]]
+    for k in range(1, len(longitudes)):
+        a, b = longitudes[k - 1], longitudes[k]
+        if abs(b - a) > 180.0:
+            side = 180.0 if a > 0 else -180.0               # the edge the line leaves by
+            t = (side - a) / ((b + 2 * side) - a)           # b unwrapped to the same side
+            crossing = float(latitudes[k - 1] + t * (latitudes[k] - latitudes[k - 1]))
+            parts.append(current + [[side, crossing]])
+            current = [[-side, crossing]]
+        current.append([longitudes[k], latitudes[k]])
+    parts.append(current)
+    return {"type": "MultiLineString",
+            "coordinates": [[[float(x), float(y)] for x, y in part] for part in parts]}
+
+
 def geojson_dict(mission: Mission) -> dict:
     """The mission as a GeoJSON FeatureCollection."""
     path = mission.path
     latitudes, longitudes = flight_path_deg(mission)
     features = [{
         "type": "Feature",
-        "geometry": {"type": "LineString",
-                     "coordinates": np.column_stack([longitudes, latitudes]).tolist()},
+        "geometry": line_geometry(latitudes, longitudes),
         # length_m: this line (take-off's end to the last target); flight_length_m: what plan
         # reports as the flight (take-off to the return); tour_length_m: the closed tour.
         "properties": {"kind": "flight_path", "length_m": path.chain.length_m,
