@@ -13,8 +13,16 @@ from pathlib import Path
 from .errors import FileAccessError
 
 
+#: The path that stands for standard input (as for most command-line tools).
+STDIN = "-"
+
+
 def read_bytes(path: str | os.PathLike) -> bytes:
-    """The file's bytes, or :class:`FileAccessError` saying why not."""
+    """The file's bytes (``-``: all of standard input), or :class:`FileAccessError` saying why
+    not."""
+    if str(path) == STDIN:
+        import sys
+        return sys.stdin.buffer.read()
     path = Path(path)
     try:
         return path.read_bytes()

@@ -107,3 +107,35 @@ def test_the_api_refuses_bad_geotargets_with_its_own_words():
         GeoTargets([46.0, 46.1], [6.9, float("nan")])
     with pytest.raises(InputError, match="2 targets but 1 names"):
         GeoTargets([46.0, 46.1], [6.9, 6.91], ("a",))
+
+
+def test_targets_files_as_people_have_them(tmp_path):
+    """Semicolons or tabs, # comments, extra columns kept (and listed), an empty alt cell
+    meaning the mission's altitude -- each refused before."""
+    import numpy as np
+
+    from dtsp_mission.targets import read_targets
+    semicolons = tmp_path / "s.csv"
+    semicolons.write_text("# exported from the site survey\nname;lat;lon;alt;camera\n"
+                          "A;46.80;6.94;;yes\n# a comment between rows\nB;46.81;6.95;120;no\n")
+    targets = read_targets(semicolons)
+    assert targets.names == ("A", "B") and targets.unused_columns == ("camera",)
+    assert np.isnan(targets.altitudes_m[0]) and targets.altitudes_m[1] == 120.0
+    tabs = tmp_path / "t.csv"
+    tabs.write_text("lat\tlon\n46.80\t6.94\n46.81\t6.95\n")
+    assert len(read_targets(tabs)) == 2 and read_targets(tabs).unused_columns == ()
+
+
+def test_targets_from_standard_input():
+    import subprocess
+    import sys
+    for text in ("lat,lon\n46.80,6.94\n46.81,6.95\n46.805,6.955\n",
+                 '{"type": "FeatureCollection", "features": [' + ", ".join(
+                     '{"type": "Feature", "geometry": {"type": "Point", "coordinates": [%s, %s]}, '
+                     '"properties": {}}' % (lon, lat) for lat, lon in
+                     ((46.80, 6.94), (46.81, 6.95), (46.805, 6.955))) + "]}"):
+        result = subprocess.run([sys.executable, "-m", "dtsp_mission.cli", "plan", "-", "--radius", "80",
+                                 "--algorithm", "alternating", "--json", "-q"], input=text,
+                                capture_output=True, text=True, timeout=300)
+        assert result.returncode == 0, result.stderr
+        assert '"targets": 3' in result.stdout

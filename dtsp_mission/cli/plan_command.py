@@ -169,6 +169,9 @@ def plan(targets_file, random_count, area_file, seed, origin, rho_m, airspeed_m_
         raise UserError(f"{targets_file or 'the input'} holds {len(targets)} target(s) after "
                         "merging duplicates; a tour needs at least 2 (for one point, fly a "
                         "single waypoint)")
+    if targets.unused_columns:
+        note(f"{targets_file}: columns not used: {', '.join(targets.unused_columns)} (the "
+             "columns read are lat/lon or x/y, alt and name)")
     local, geodetic, frame = _frame(targets, origin)
     needs_mission = [output for output, writer in writers if writer.needs_mission]
     if needs_mission and frame is None:

@@ -155,6 +155,7 @@ def _design_for_guidance(path: FlightPath, tour: Tour, frame: LocalFrame, target
             if settings.airspeed_m_s is not None else [])
     altitudes = (np.full(len(tour.targets_m), settings.altitude_m) if targets.altitudes_m is None
                  else np.asarray(targets.altitudes_m, dtype=float))
+    altitudes = np.where(np.isnan(altitudes), settings.altitude_m, altitudes)   # not given
     design = design_waypoints(path, tour.targets_m, altitudes, airframe, settings.max_miss_m, budget, head,
                               settings.target_acceptance_m)
     return replace(design, s_m=np.concatenate([[0.0], design.s_m, tail]),
@@ -196,8 +197,11 @@ def build_mission(tour: Tour, frame: LocalFrame, targets: GeoTargets,
               else bearing_to_heading_rad(settings.launch_bearing_deg))
     landing = (None if settings.landing_bearing_deg is None
                else bearing_to_heading_rad(settings.landing_bearing_deg))
+    altitudes = targets.altitudes_m
+    if altitudes is not None:       # NaN: not given in the targets file, the mission's altitude
+        altitudes = np.where(np.isnan(altitudes), settings.altitude_m, altitudes)
     path = plan_flight_path(tour, home_m, settings.altitude_m, settings.return_mode, launch,
-                            landing, targets.altitudes_m)
+                            landing, altitudes)
     launch_heading = path.chain.starts[0, 2]
     if settings.launch_bearing_deg is None:
         notes.append(f"launch bearing not given: towards the first target "

@@ -4,17 +4,20 @@ A header row names the columns (case and surrounding spaces ignored):
 
 - ``lat``/``latitude`` and ``lon``/``lng``/``longitude``: degrees -> :class:`GeoTargets`;
 - ``x``/``x_m`` and ``y``/``y_m``: metres east and north of an origin -> :class:`Targets`;
-- optional ``alt``/``altitude``/``alt_m`` (metres above home) and ``name``.
+- optional ``alt``/``altitude``/``alt_m`` (metres above home; an empty cell: the mission's
+  altitude) and ``name``.
 
-Any other column is an error, so a typo is never silently ignored.  Errors name the file, line
-and column.
+Fields are separated by commas, semicolons or tabs (whichever the header uses); lines starting
+with ``#`` are comments.  Other columns are kept out of the way: they are read, not used, and
+listed in :attr:`~dtsp_mission.targets.model.GeoTargets.unused_columns` so that a typo in a
+column name is still shown to the user.  Errors name the file, line and column.
 """
 
 from __future__ import annotations
 
 import csv
-import io
 import os
+from dataclasses import replace
 
 import numpy as np
 
@@ -30,46 +33,65 @@ _COLUMNS = {
 }
 
 
-def _header(path, header: list[str]) -> dict[str, int]:
+def _header(path, header: list[str], line: int) -> tuple[dict[str, int], tuple[str, ...]]:
     found: dict[str, int] = {}
+    unused = []
     for index, raw in enumerate(header):
         label = raw.strip().lower()
         for key, spellings in _COLUMNS.items():
             if label in spellings:
                 if key in found:
-                    raise FileFormatError(f"{path}, line 1: column {key!r} is given twice")
+                    raise FileFormatError(f"{path}, line {line}: column {key!r} is given twice")
                 found[key] = index
                 break
         else:
-            raise FileFormatError(
-                f"{path}, line 1: unknown column {raw.strip()!r}; the columns are lat and lon "
-                "(degrees) or x and y (metres), with optional alt (metres above home) and name")
+            unused.append(raw.strip())
     geodetic = "lat" in found and "lon" in found
     local = "x" in found and "y" in found
     if geodetic == local:
         raise FileFormatError(
-            f"{path}, line 1: the header must name either columns lat and lon (degrees) or "
-            f"x and y (metres); found {', '.join(h.strip() for h in header)}")
-    return found
+            f"{path}, line {line}: the header must name either columns lat and lon (degrees) or "
+            f"x and y (metres), with optional alt (metres above home) and name; found "
+            f"{', '.join(h.strip() for h in header)}")
+    return found, tuple(unused)
 
 
-def read_csv(path: str | os.PathLike) -> GeoTargets | Targets:
-    """Targets from a CSV file; duplicates (same coordinates) are merged and counted."""
-    text = read_text(path)
-    rows = [row for row in csv.reader(io.StringIO(text)) if any(cell.strip() for cell in row)]
-    if not rows:
+def _delimiter(header_line: str) -> str:
+    """The separator the header uses: a tab, a semicolon or (the default) a comma."""
+    counts = {delimiter: header_line.count(delimiter) for delimiter in ("\t", ";", ",")}
+    best = max(counts, key=counts.get)
+    return best if counts[best] else ","
+
+
+def read_csv(path: str | os.PathLike, text: str | None = None) -> GeoTargets | Targets:
+    """Targets from a CSV file (``text``: its content, already read); duplicates (same
+    coordinates) are merged and counted."""
+    text = read_text(path) if text is None else text
+    numbered = [(k, line) for k, line in enumerate(text.splitlines(), start=1)
+                if line.strip() and not line.lstrip().startswith("#")]
+    if not numbered:
         raise FileFormatError(f"{path}: the file is empty")
-    columns = _header(path, rows[0])
+    delimiter = _delimiter(numbered[0][1])
+    rows, line_of = [], []
+    for k, line in numbered:
+        row = next(csv.reader([line], delimiter=delimiter))
+        if any(cell.strip() for cell in row):
+            rows.append(row)
+            line_of.append(k)
+    columns, unused = _header(path, rows[0], line_of[0])
     geodetic = "lat" in columns
     first, second = ("lat", "lon") if geodetic else ("x", "y")
     numbers: dict[str, list[float]] = {key: [] for key in (first, second, "alt") if key in columns}
     names: list[str] = []
-    for line, row in enumerate(rows[1:], start=2):
+    for line, row in zip(line_of[1:], rows[1:]):
         if len(row) != len(rows[0]):
             raise FileFormatError(f"{path}, line {line}: {len(row)} fields where the header has "
                                   f"{len(rows[0])}")
         for key, values in numbers.items():
             cell = row[columns[key]].strip()
+            if key == "alt" and not cell:
+                values.append(float("nan"))          # the mission's altitude
+                continue
             try:
                 value = float(cell)
             except ValueError:
@@ -85,8 +107,12 @@ def read_csv(path: str | os.PathLike) -> GeoTargets | Targets:
         raise FileFormatError(f"{path}: there are no targets below the header")
     altitudes = np.array(numbers["alt"]) if "alt" in numbers else None
     check_altitudes(altitudes, str(path))
+    if altitudes is not None and np.isnan(altitudes).all():
+        altitudes = None
     name_tuple = tuple(names) if "name" in columns else None
     if geodetic:
         check_geodetic(numbers["lat"], numbers["lon"], f"{path}: target")
-        return geodetic_targets(numbers["lat"], numbers["lon"], name_tuple, altitudes)
-    return local_targets(np.column_stack([numbers["x"], numbers["y"]]), name_tuple, altitudes)
+        targets = geodetic_targets(numbers["lat"], numbers["lon"], name_tuple, altitudes)
+    else:
+        targets = local_targets(np.column_stack([numbers["x"], numbers["y"]]), name_tuple, altitudes)
+    return replace(targets, unused_columns=unused) if unused else targets

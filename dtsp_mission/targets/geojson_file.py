@@ -53,9 +53,10 @@ def area_from_geometry(geometry: dict, where: str) -> np.ndarray:
     return ring[:, ::-1].copy()
 
 
-def read_geojson(path: str | os.PathLike) -> GeoTargets:
-    """Targets (possibly none, if the file only holds a survey area) and the survey area."""
-    text = read_text(path)
+def read_geojson(path: str | os.PathLike, text: str | None = None) -> GeoTargets:
+    """Targets (possibly none, if the file only holds a survey area) and the survey area;
+    ``text``: the content, already read from ``path``."""
+    text = read_text(path) if text is None else text
     try:
         data = json.loads(text)
     except json.JSONDecodeError as error:

@@ -24,7 +24,8 @@ class Targets:
     positions_m: np.ndarray
     names: tuple[str, ...] | None = None
     merged_duplicates: int = 0      # how many repeated positions were dropped
-    altitudes_m: np.ndarray | None = None
+    altitudes_m: np.ndarray | None = None      # NaN: the mission's altitude
+    unused_columns: tuple[str, ...] = ()       # columns of the file that were not used
 
     def __len__(self) -> int:
         return len(self.positions_m)
@@ -33,7 +34,7 @@ class Targets:
         """The same targets in degrees, through ``frame``."""
         latitudes, longitudes = frame.to_geodetic(self.positions_m)
         return GeoTargets(latitudes, longitudes, self.names, self.merged_duplicates,
-                          self.altitudes_m)
+                          self.altitudes_m, unused_columns=self.unused_columns)
 
 
 @dataclass(frozen=True)
@@ -48,8 +49,9 @@ class GeoTargets:
     longitudes_deg: np.ndarray
     names: tuple[str, ...] | None = None
     merged_duplicates: int = 0
-    altitudes_m: np.ndarray | None = None
+    altitudes_m: np.ndarray | None = None      # NaN: the mission's altitude
     area_deg: np.ndarray | None = None
+    unused_columns: tuple[str, ...] = ()       # columns of the file that were not used
 
     def __post_init__(self) -> None:
         """Raise :class:`InputError` (a message for a caller of the API, naming no command-line
@@ -79,7 +81,7 @@ class GeoTargets:
         """The same targets in the local frame (after checking they fit in it)."""
         frame.check_extent(self.latitudes_deg, self.longitudes_deg)
         return Targets(frame.to_local(self.latitudes_deg, self.longitudes_deg), self.names,
-                       self.merged_duplicates, self.altitudes_m)
+                       self.merged_duplicates, self.altitudes_m, self.unused_columns)
 
     def with_area(self, area_deg: np.ndarray | None) -> "GeoTargets":
         return replace(self, area_deg=area_deg)
@@ -93,10 +95,12 @@ class GeoTargets:
 
 
 def check_altitudes(altitudes_m: np.ndarray | None, where: str) -> None:
-    """Raise :class:`InputError` unless every altitude is a finite number above zero."""
+    """Raise :class:`InputError` unless every altitude is a finite number above zero (or NaN:
+    not given, the mission's altitude)."""
     if altitudes_m is None:
         return
-    bad = ~np.isfinite(altitudes_m) | (altitudes_m <= 0.0)
+    given = ~np.isnan(altitudes_m)
+    bad = given & (~np.isfinite(altitudes_m) | (altitudes_m <= 0.0))
     if bad.any():
         index = int(np.argmax(bad))
         raise InputError(f"{where}, target {index + 1}: altitude {float(altitudes_m[index])!r} m must be "

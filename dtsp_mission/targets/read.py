@@ -6,6 +6,7 @@ import os
 from pathlib import Path
 
 from ..errors import FileFormatError
+from ..files import STDIN, read_text
 from .csv_file import read_csv
 from .geojson_file import read_geojson
 from .model import GeoTargets, Targets
@@ -14,7 +15,12 @@ READERS = {".csv": read_csv, ".txt": read_csv, ".geojson": read_geojson, ".json"
 
 
 def read_targets(path: str | os.PathLike) -> GeoTargets | Targets:
-    """Targets from a CSV (``.csv``/``.txt``) or GeoJSON (``.geojson``/``.json``) file."""
+    """Targets from a CSV (``.csv``/``.txt``) or GeoJSON (``.geojson``/``.json``) file, or
+    from standard input (``-``: GeoJSON if it starts with ``{``, else CSV)."""
+    if str(path) == STDIN:
+        text = read_text(STDIN)
+        reader = read_geojson if text.lstrip().startswith("{") else read_csv
+        return reader("standard input", text)
     suffix = Path(path).suffix.lower()
     if suffix not in READERS:
         raise FileFormatError(f"{path}: cannot tell the format from {suffix or 'no extension'!r}; "
