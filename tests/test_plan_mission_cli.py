@@ -175,3 +175,31 @@ def test_a_site_across_the_antimeridian_gives_a_geojson_line_cut_there(tmp_path)
     starts = [part[0] for part in geometry["coordinates"][1:]]
     assert all(abs(e[0]) == 180.0 and s[0] == -e[0] and s[1] == e[1] for e, s in zip(ends, starts))
     assert line.is_valid
+
+
+def test_sanity_checks_refuse_or_warn_with_a_clear_message(tmp_path):
+    """A radius the aircraft cannot bank for, an altitude no fixed wing flies, --endurance
+    without a speed: refused (exit 2); a home far from every target: a note."""
+    targets = tmp_path / "t.csv"
+    targets.write_text("lat,lon\n46.80,6.94\n46.81,6.95\n46.805,6.955\n")
+    steep = run(targets, "--radius", 5, "--airspeed", 22)
+    assert steep.returncode == 2 and "needs 84 deg of bank, beyond the aircraft's roll limit of 65 deg" \
+        in steep.stderr and "no tighter than 23 m" in steep.stderr
+    high = run(targets, "--radius", 80, "--alt", 50000)
+    assert high.returncode == 2 and "altitude 50000 m above home is beyond 10000 m" in high.stderr
+    assert "needs --airspeed" in run(targets, "--radius", 80, "--endurance", 10).stderr
+    far = run(targets, "--radius", 80, "--home", "46.5,6.5", "-o", tmp_path / "far.plan",
+              "--time-limit", 0)
+    assert far.returncode == 0 and "home is 47.4 km from the nearest target: is --home right?" in far.stderr
+
+
+def test_a_flight_beyond_the_endurance_is_split_into_sorties_that_each_fit(tmp_path):
+    out = tmp_path / "site.plan"
+    result = run(SITE, "--radius", 80, "--airspeed", 22, "--endurance", 15, "-o", out,
+                 "--time-limit", 1, "--json", "-q")
+    assert result.returncode == 0, result.stderr
+    summary = json.loads(result.stdout)
+    assert len(summary["sorties"]) >= 2 and sum(s["targets"] for s in summary["sorties"]) == 272
+    assert all(s["flight_time_s"] <= 15 * 60 for s in summary["sorties"])
+    assert [Path(f).name for f in summary["files"]] == [f"site-{k}.plan" for k in
+                                                        range(1, len(summary["sorties"]) + 1)]

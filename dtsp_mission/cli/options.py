@@ -128,9 +128,13 @@ def apply(options: list) -> Callable:
 
 
 def turn_radius_from(rho_m: float | None, airspeed_m_s: float | None,
-                     max_bank_deg: float | None) -> tuple[float, str]:
-    """The turn radius and where it came from, from the vehicle options."""
+                     max_bank_deg: float | None, roll_limit_deg: float | None = None) -> tuple[float, str]:
+    """The turn radius and where it came from, from the vehicle options; UserError for a
+    radius the aircraft cannot turn at its airspeed (a bank beyond ``roll_limit_deg``, its
+    ROLL_LIMIT_DEG: a stock ArduPlane's unless given)."""
+    from ..autopilot.parameters import ARDUPLANE_DEFAULTS
     from ..vehicle import bank_for_radius_deg, turn_radius_m
+    limit = ARDUPLANE_DEFAULTS.ROLL_LIMIT_DEG if roll_limit_deg is None else roll_limit_deg
     if max_bank_deg is not None:
         if rho_m is not None:
             raise UserError("give either --radius or --airspeed with --max-bank, not both")
@@ -142,8 +146,13 @@ def turn_radius_from(rho_m: float | None, airspeed_m_s: float | None,
     if rho_m is None:
         raise UserError("give the turn radius: --radius METRES, or --airspeed and --max-bank")
     if airspeed_m_s is not None and rho_m > 0 and airspeed_m_s > 0:
-        return rho_m, (f"rho {rho_m:g} m (a {bank_for_radius_deg(airspeed_m_s, rho_m):.0f} deg "
-                       f"bank at {airspeed_m_s:g} m/s)")
+        bank = bank_for_radius_deg(airspeed_m_s, rho_m)
+        if bank > limit:
+            raise UserError(f"--radius {rho_m:g} m at {airspeed_m_s:g} m/s needs {bank:.0f} deg "
+                            f"of bank, beyond the aircraft's roll limit of {limit:g} deg "
+                            f"(ROLL_LIMIT_DEG): at that speed it turns no tighter than "
+                            f"{turn_radius_m(airspeed_m_s, limit):.0f} m")
+        return rho_m, (f"rho {rho_m:g} m (a {bank:.0f} deg bank at {airspeed_m_s:g} m/s)")
     return rho_m, f"rho {rho_m:g} m"
 
 

@@ -135,6 +135,9 @@ def _duration(seconds: float) -> str:
               help="Upload the mission to this vehicle after writing the files "
                    "(udpout:HOST:PORT, ...); see `dtsp-mission upload`.")
 @apply(link_options)
+@click.option("--endurance", "endurance_min", type=click.FloatRange(min=0.0, min_open=True),
+              metavar="MINUTES", help="Longest flight the aircraft can make (take-off to the "
+              "return, at --airspeed): a longer mission is split into sorties that each fit.")
 @click.option("--simulate", is_flag=True, help="Fly the mission in the simulator (an ArduPlane "
               "with --vehicle-params, stock without) and print per-target miss distances.")
 @apply(simulation_options)
@@ -144,7 +147,8 @@ def plan(targets_file, random_count, area_file, seed, origin, rho_m, airspeed_m_
          altitude_m, home_deg, home_amsl_m, launch_bearing_deg, landing_bearing_deg, autopilot,
          return_mode, design, max_miss_m, tolerance_m, max_items, algorithm, region, time_limit_s,
          fallback, outputs, format_name,
-         plot_file, connection, via, verify, signing_key_file, transfer_timeout_s, simulate, speedup,
+         plot_file, connection, via, verify, signing_key_file, transfer_timeout_s, endurance_min,
+         simulate, speedup,
          vehicle_params_file, l1_period_s, quiet, as_json) -> None:
     """Plan a Dubins tour through the targets and write it as a mission.
 
@@ -154,6 +158,8 @@ def plan(targets_file, random_count, area_file, seed, origin, rho_m, airspeed_m_
     Example: dtsp-mission plan examples/site-inspection.csv --radius 80 --alt 120 -o mission.plan
     """
     console.start(quiet, as_json)
+    if endurance_min is not None and airspeed_m_s is None:
+        raise UserError("--endurance needs --airspeed: the flight time follows from it")
     writers = [(output, exporter_for(output, format_name)) for output in outputs]
     if plot_file:
         require_matplotlib()
@@ -163,7 +169,9 @@ def plan(targets_file, random_count, area_file, seed, origin, rho_m, airspeed_m_
         MissionSettings(max_items=max_items).checked(1.0)
     if algorithm in ("rbta", "auto") and region not in ("bounding", "min-area"):
         region_heading_deg(region)
-    rho, rho_source = turn_radius_from(rho_m, airspeed_m_s, max_bank_deg)
+    designed_for = _designed_for(vehicle_params_file)
+    rho, rho_source = turn_radius_from(rho_m, airspeed_m_s, max_bank_deg,
+                                       designed_for.ROLL_LIMIT_DEG if designed_for else None)
     targets = _targets(targets_file, random_count, area_file, seed)
     if len(targets) < 2:
         raise UserError(f"{targets_file or 'the input'} holds {len(targets)} target(s) after "
@@ -226,7 +234,10 @@ def plan(targets_file, random_count, area_file, seed, origin, rho_m, airspeed_m_
                 # Only the tour is asked for: the vehicle's storage does not limit it.
                 note(f"as one mission this would not fit the vehicle: {error}")
             else:
-                sorties = _split(tour, frame, geodetic, settings, error)
+                sorties = _split(tour, frame, geodetic, settings,
+                                 f"as one mission it needs {error.needed} items (at least) but "
+                                 f"the vehicle holds {error.capacity} (--max-items)",
+                                 endurance_min and endurance_min * 60)
         if isinstance(product, Mission) and "predicted_miss_m" in product.summary:
             planner = get_planner(algorithm, **parameters)
             widened = with_turn_margin(product, lambda r: planner.plan(local.positions_m, r),
@@ -240,6 +251,13 @@ def plan(targets_file, random_count, area_file, seed, origin, rho_m, airspeed_m_
                 product, tour = widened, widened.tour
         if isinstance(product, Mission):
             _report_mission(product)
+            flight_s = product.summary.get("flight_time_s", 0.0)
+            if endurance_min is not None and flight_s > endurance_min * 60:
+                sorties = _split(tour, frame, geodetic, settings,
+                                 f"the flight takes {flight_s / 60:.1f} min, more than the "
+                                 f"endurance of {endurance_min:g} min (--endurance)",
+                                 endurance_min * 60)
+            _warn_far_home(product, local.positions_m, frame)
     elif airspeed_m_s:
         say(f"flight time of the tour at {airspeed_m_s:g} m/s: "
                    f"{_duration(tour.length_m / airspeed_m_s)}")
@@ -285,17 +303,16 @@ def plan(targets_file, random_count, area_file, seed, origin, rho_m, airspeed_m_
     console.finish()
 
 
-def _split(tour, frame, geodetic, settings, error):
-    """The sorties of a mission too large for the vehicle, printed."""
+def _split(tour, frame, geodetic, settings, reason: str, endurance_s: float | None = None):
+    """The sorties of a mission too large or too long for the vehicle, printed."""
     home_m = (frame.to_local(*settings.home_deg)[0] if settings.home_deg is not None
               else np.zeros(2))
-    sorties = split_into_sorties(tour, frame, geodetic, settings, home_m)
+    sorties = split_into_sorties(tour, frame, geodetic, settings, home_m, endurance_s)
     record(sorties=[{"targets": len(s.targets), "items": s.mission.summary["items"],
                      "flight_length_m": s.mission.summary["flight_length_m"],
                      "flight_time_s": s.mission.summary.get("flight_time_s")} for s in sorties])
-    say(f"as one mission it needs {error.needed} items (at least) but the vehicle holds "
-               f"{error.capacity} (--max-items): split into {len(sorties)} sorties, each a "
-               "take-off, a contiguous part of the tour and the return, balanced by flight time:")
+    say(f"{reason}: split into {len(sorties)} sorties, each a take-off, a contiguous part of "
+        "the tour and the return, balanced by flight time:")
     names = geodetic.names
     for k, sortie in enumerate(sorties):
         summary = sortie.mission.summary
@@ -310,6 +327,21 @@ def _split(tour, frame, geodetic, settings, error):
                    f"{summary['flight_length_m'] / 1e3:,.2f} km{time_text}"
                    + (f", {beyond} predicted beyond --max-miss" if beyond else ""))
     return sorties
+
+
+#: A home farther than this from every target is worth a second look.
+FAR_HOME_M = 10_000.0
+
+
+def _warn_far_home(mission, targets_m: np.ndarray, frame) -> None:
+    """A note when home (or the launch point) is far from every target: a wrong --home
+    (swapped lat/lon, another site) shows up before the flight, not in it."""
+    home_m = frame.to_local(np.array([mission.home.latitude_deg]),
+                            np.array([mission.home.longitude_deg]))[0]
+    nearest = float(np.hypot(*(targets_m - home_m).T).min())
+    if nearest > FAR_HOME_M:
+        note(f"home is {nearest / 1000:.1f} km from the nearest target: is --home right? "
+             "(the transit there and back is part of every flight)")
 
 
 def _designed_for(vehicle_params_file):

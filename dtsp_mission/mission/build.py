@@ -42,12 +42,17 @@ RETURN_MODES = ("rtl", "land", "none")
 DESIGNS = ("guidance", "geometry")
 
 
+#: The highest altitude above home a mission may use: beyond it a number is far more likely a
+#: typo (or feet) than a fixed-wing survey.
+MAX_ALTITUDE_M = 10_000.0
+
+
 @dataclass(frozen=True)
 class MissionSettings:
     """How to turn a tour into a mission.  ``None`` means the default stated in each note."""
 
     autopilot: str = "ardupilot"
-    altitude_m: float = 100.0              # cruise altitude above home
+    altitude_m: float = 100.0              # cruise altitude above home (at most MAX_ALTITUDE_M)
     airspeed_m_s: float | None = None
     home_deg: tuple[float, float] | None = None       # (lat, lon); default the mission centre
     home_altitude_amsl_m: float = 0.0
@@ -69,6 +74,10 @@ class MissionSettings:
         if not (math.isfinite(self.altitude_m) and self.altitude_m > 0):
             raise InputError(f"altitude must be a number above 0 m (above home), got "
                              f"{self.altitude_m!r}")
+        if self.altitude_m > MAX_ALTITUDE_M:
+            raise InputError(f"altitude {self.altitude_m:g} m above home is beyond "
+                             f"{MAX_ALTITUDE_M:g} m, higher than the fixed wings this plans for "
+                             "fly (a typo, or feet for metres?)")
         if self.airspeed_m_s is not None and not (math.isfinite(self.airspeed_m_s)
                                                   and self.airspeed_m_s > 0):
             raise InputError(f"airspeed must be a number above 0 m/s, got {self.airspeed_m_s!r}")

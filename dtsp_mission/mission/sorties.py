@@ -71,10 +71,12 @@ def _cuts(arc_m: np.ndarray, to_home_m: np.ndarray, count: int, first: int) -> t
 
 
 def split_into_sorties(tour: Tour, frame: LocalFrame, targets: GeoTargets,
-                       settings: MissionSettings, home_m: np.ndarray) -> list[Sortie]:
-    """The fewest sorties (at least 2) whose missions each fit ``settings.max_items``,
-    balanced by estimated flight time; :class:`InputError` if none up to :data:`MAX_SORTIES`
-    does."""
+                       settings: MissionSettings, home_m: np.ndarray,
+                       endurance_s: float | None = None) -> list[Sortie]:
+    """The fewest sorties (at least 2) whose missions each fit ``settings.max_items`` and,
+    with ``endurance_s``, each fly within it (from take-off to the return, at the mission's
+    airspeed), balanced by estimated flight time; :class:`InputError` if none up to
+    :data:`MAX_SORTIES` does."""
     n = len(tour.targets_m)
     order = tour.visit_order
     poses = tour.visit_poses()[order]
@@ -98,12 +100,21 @@ def split_into_sorties(tour: Tour, frame: LocalFrame, targets: GeoTargets,
                 part = tour_through_poses(tour.targets_m[chosen], np.arange(len(chosen)),
                                           poses[piece, 2], tour.rho_m, tour.planner, tour.parameters)
                 mission = build_mission(part, frame, targets.subset(chosen), settings)
+                flight_s = mission.summary.get("flight_time_s", 0.0)
+                if endurance_s is not None and flight_s > endurance_s:
+                    raise _TooLong(f"a sortie would fly {flight_s / 60:.1f} min, more than the "
+                                   f"endurance of {endurance_s / 60:g} min")
                 sorties.append(Sortie(chosen, mission))
             return sorties
-        except MissionTooLarge as error:
+        except (MissionTooLarge, _TooLong) as error:
             last_error = error
-    raise InputError(f"even {min(MAX_SORTIES, n)} sorties do not fit the vehicle's "
-                     f"{settings.max_items} items: {last_error}")
+    raise InputError(f"even {min(MAX_SORTIES, n)} sorties do not fit the vehicle "
+                     f"({settings.max_items} items"
+                     f"{f', {endurance_s / 60:g} min of endurance' if endurance_s else ''}): {last_error}")
+
+
+class _TooLong(Exception):
+    """A sortie longer than the endurance."""
 
 
 def sortie_path(path: str, index: int) -> str:

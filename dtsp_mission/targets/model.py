@@ -100,11 +100,11 @@ def check_altitudes(altitudes_m: np.ndarray | None, where: str) -> None:
     if altitudes_m is None:
         return
     given = ~np.isnan(altitudes_m)
-    bad = given & (~np.isfinite(altitudes_m) | (altitudes_m <= 0.0))
+    bad = given & (~np.isfinite(altitudes_m) | (altitudes_m <= 0.0) | (altitudes_m > 10_000.0))
     if bad.any():
         index = int(np.argmax(bad))
         raise InputError(f"{where}, target {index + 1}: altitude {float(altitudes_m[index])!r} m must be "
-                         "a number above 0 (metres above home)")
+                         "a number above 0 and at most 10,000 (metres above home)")
 
 
 def cluster_positions(positions: np.ndarray, resolution: float = 0.0) -> tuple[np.ndarray, np.ndarray]:
