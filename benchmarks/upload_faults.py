@@ -14,6 +14,7 @@ from __future__ import annotations
 
 import argparse
 import statistics
+from collections import Counter
 import sys
 import time
 
@@ -30,8 +31,9 @@ HOME = Home(46.8, 6.95, 450.0)
 #: Mission slots of the vehicle: an ArduPilot board with SD storage (a stock one holds 655).
 STORAGE = 4000
 
-#: (mission slots, loss, duplicates, reordering, delay_s): the issue's rows and the clean
-#: references the time ratio is taken against.
+#: (mission slots, loss, duplicates, reordering, delay_s[, transfer timeout_s]): the issue's
+#: rows, the clean references the time ratio is taken against, and a link so bad (with a short
+#: --timeout) that uploads fail, to check what the failures say against what the vehicle holds.
 ROWS = [
     (100, 0.0, 0.0, 0.0, 0.0),
     (100, 0.05, 0.0, 0.0, 0.0),
@@ -42,6 +44,7 @@ ROWS = [
     (1000, 0.05, 0.10, 0.10, 0.020),
     (1000, 0.20, 0.0, 0.0, 0.0),
     (1000, 0.20, 0.10, 0.10, 0.0),
+    (300, 0.50, 0.0, 0.0, 0.0, 3.0),
 ]
 
 
@@ -52,7 +55,8 @@ def synthetic_mission(slots: int, altitude_m: float = 100.0) -> VehicleMission:
     return VehicleMission(items, HOME, Autopilot.ARDUPILOTMEGA)
 
 
-def one_run(mission: VehicleMission, faults: Faults, earlier: VehicleMission) -> dict:
+def one_run(mission: VehicleMission, faults: Faults, earlier: VehicleMission,
+            timeout_s: float | None = None) -> dict:
     """One verified upload over the damaged link to a vehicle that holds ``earlier``."""
     wire = to_wire(mission)
     with SimulatedVehicle(VehicleSettings(HOME, mission.autopilot, max_items=STORAGE)) as vehicle:
@@ -60,13 +64,16 @@ def one_run(mission: VehicleMission, faults: Faults, earlier: VehicleMission) ->
         with FaultProxy(("127.0.0.1", vehicle.port), faults) as proxy:
             started = time.perf_counter()
             try:
-                report = upload_mission(mission, f"udpout:127.0.0.1:{proxy.port}")
+                report = upload_mission(mission, f"udpout:127.0.0.1:{proxy.port}", timeout_s=timeout_s,
+                                        heartbeat_timeout_s=20.0)
             except LinkError as error:
                 elapsed = time.perf_counter() - started
-                time.sleep(0.2)
+                while vehicle.server.receiving:        # until it gives the upload up itself
+                    time.sleep(0.1)
                 truth = describe_vehicle(vehicle.mission, wire, mission.autopilot)
                 said = error.on_vehicle
-                honest = said == truth or "unknown" in said
+                # honest: the true state, or a plain "unknown" / "not verified"
+                honest = said == truth or "unknown" in said or "not verified" in said
                 return {"ok": False, "seconds": elapsed, "reason": error.reason[:70],
                         "honest": honest, "said": said, "truth": truth}
             holds = not differences(wire, vehicle.mission, mission.autopilot)
@@ -88,18 +95,20 @@ def main() -> None:
              "| median total (s) | x clean | resent per slot | fresh starts |",
              "|---:|---:|---:|---:|---:|---:|---:|---|---:|---:|---:|---:|---:|---:|"]
     clean: dict[int, float] = {}
-    for slots, loss, duplicate, reorder, delay in chosen:
+    for slots, loss, duplicate, reorder, delay, *timeout in chosen:
         mission = synthetic_mission(slots)
         runs = []
         for seed in range(args.runs):
             faults = Faults(drop=loss, duplicate=duplicate, reorder=reorder, delay_s=delay, seed=seed)
-            runs.append(one_run(mission, faults, earlier))
+            runs.append(one_run(mission, faults, earlier, *timeout))
             print(f"  {slots} {loss:.0%} {duplicate:.0%} {reorder:.0%} {delay * 1000:.0f} ms seed {seed}: "
                   f"{runs[-1]}", file=sys.stderr, flush=True)
         good = [r for r in runs if r["ok"]]
         false = sum(r.get("false_success", False) for r in runs)
         failures = [r for r in runs if not r["ok"] and "honest" in r]
-        said = "; ".join(sorted({("" if r["honest"] else "WRONG: ") + r["said"] for r in failures})) or "-"
+        said = "; ".join(f"{count}x {text}" for text, count in sorted(Counter(
+            ("" if r["honest"] else f"WRONG (it held: {r['truth']}): ") + r["said"]
+            for r in failures).items())) or "-"
         transfer = statistics.median(r["transfer_s"] for r in good) if good else float("nan")
         total = statistics.median(r["seconds"] for r in good) if good else float("nan")
         worst = max((r["transfer_s"] for r in good), default=float("nan"))
@@ -108,7 +117,8 @@ def main() -> None:
         ratio = f"{transfer / clean[slots]:.1f}" if slots in clean and good else "-"
         resent = statistics.median(r["resent"] / slots for r in good) if good else float("nan")
         fresh = sum(r["fresh"] for r in good)
-        line = (f"| {slots} | {loss:.0%} | {duplicate:.0%} | {reorder:.0%} | {delay * 1000:.0f} ms | "
+        limit = f" (--timeout {timeout[0]:g})" if timeout else ""
+        line = (f"| {slots}{limit} | {loss:.0%} | {duplicate:.0%} | {reorder:.0%} | {delay * 1000:.0f} ms | "
                 f"{len(good)}/{len(runs)} | {false} | {said} | {transfer:.2f} | {worst:.2f} | {total:.2f} | "
                 f"{ratio} | {resent:.2f} | {fresh} |")
         print(line, flush=True)

@@ -1,5 +1,5 @@
-"""Upload time on loopback UDP to the simulated vehicle (MAVSDK's mission_raw_server), for
-100, 1000 and 5000 items, each uploader, with and without datagram loss.
+"""Upload time on loopback UDP to the simulated vehicle (its own ArduPilot-like mission
+server), for 100, 1000 and 5000 items, each uploader, with and without datagram loss.
 
 Prints a Markdown table (median of the repeats; failures are shown, not hidden) and, with
 ``--markdown FILE``, writes it there.  Run: python benchmarks/upload_times.py --markdown docs/upload-benchmark.md
@@ -31,7 +31,7 @@ def synthetic_mission(count: int) -> VehicleMission:
 
 
 def one_upload(mission: VehicleMission, via: str, loss: float, seed: int) -> tuple[float, str]:
-    with SimulatedVehicle(VehicleSettings(HOME, mission.autopilot)) as vehicle:
+    with SimulatedVehicle(VehicleSettings(HOME, mission.autopilot, max_items=6000)) as vehicle:
         target = ("127.0.0.1", vehicle.port)
         faults = Faults(drop=loss, seed=seed)
         with FaultProxy(target, faults) as proxy:
@@ -76,9 +76,10 @@ def main() -> None:
     if args.markdown:
         write_atomic(args.markdown, "# Upload times on loopback\n\nProduced by "
                      "`python benchmarks/upload_times.py --markdown docs/upload-benchmark.md` "
-                     "(upload only, no verification download; the simulated vehicle is MAVSDK's "
-                     "mission_raw_server behind dtsp-mission's UDP front; loss is the fault "
-                     "proxy dropping datagrams in both directions).\n\n" + table + "\n")
+                     "(upload only, no verification download; the simulated vehicle serves the "
+                     "mission protocol as ArduPilot does, with 6,000 slots; loss is the fault "
+                     "proxy dropping datagrams in both directions; the verified, faulty-link "
+                     "figures are in upload-faults.md).\n\n" + table + "\n")
 
 
 if __name__ == "__main__":

@@ -99,7 +99,7 @@ def test_the_api_refuses_bad_geotargets_with_its_own_words():
 
     from dtsp_mission.errors import InputError
     from dtsp_mission.targets import GeoTargets
-    with pytest.raises(InputError, match=r"target 1: latitude 91.0 is not a number of degrees between -90 and 90"):
+    with pytest.raises(InputError, match=r"target 1: latitude 91.0 is not a number between -90 and 90 degrees"):
         GeoTargets(np.array([91.0, 46.0]), np.array([6.9, 6.91]))
     with pytest.raises(InputError, match="one latitude and one longitude per target: got 3 latitudes and 2"):
         GeoTargets(np.array([46.0, 46.1, 46.2]), np.array([6.9, 6.91]))

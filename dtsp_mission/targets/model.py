@@ -62,12 +62,8 @@ class GeoTargets:
         if latitudes.ndim != 1 or longitudes.ndim != 1 or len(latitudes) != len(longitudes):
             raise InputError(f"GeoTargets needs one latitude and one longitude per target: got "
                              f"{latitudes.size} latitudes and {longitudes.size} longitudes")
-        for name, values, limit in (("latitude", latitudes, 90.0), ("longitude", longitudes, 180.0)):
-            bad = ~np.isfinite(values) | (np.abs(values) > limit)
-            if bad.any():
-                index = int(np.argmax(bad))
-                raise InputError(f"target {index + 1}: {name} {float(values[index])!r} is not a "
-                                 f"number of degrees between -{limit:g} and {limit:g}")
+        from ..frame import check_geodetic
+        check_geodetic(latitudes, longitudes)
         for label, values in (("names", self.names), ("altitudes", self.altitudes_m)):
             if values is not None and len(values) != len(latitudes):
                 raise InputError(f"GeoTargets has {len(latitudes)} targets but {len(values)} {label}")

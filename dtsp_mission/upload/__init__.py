@@ -17,7 +17,7 @@ from ..autopilot.parameters import ARDUPLANE_DEFAULTS, NAMES, VehicleParameters,
 from ..errors import InputError, LinkError
 from ..mission import VehicleMission
 from ..plugins import load_group, working
-from .base import Progress, Uploader, VehicleInfo
+from .base import VEHICLE_GIVES_UP_S, Progress, Uploader, VehicleInfo
 from .wire import WireItem, describe_vehicle, differences, to_wire
 
 UPLOADER_GROUP = "dtsp_mission.uploaders"
@@ -166,7 +166,15 @@ def _round_trip(uploader: Uploader) -> float | None:
     return getattr(timer, "srtt_s", None)
 
 
+#: After a failed upload, what the vehicle holds is asked for this long at least: ArduPilot
+#: refuses downloads (DENIED) until it gives the broken upload up itself, after 8 s.
+AFTER_FAILURE_S = VEHICLE_GIVES_UP_S + 4.0
+
+
 def _download_or_none(uploader: Uploader) -> list[WireItem] | None:
+    """The vehicle's mission after a failure, or None if it cannot be had either."""
+    if uploader.timeout_s is not None:
+        uploader.timeout_s = max(uploader.timeout_s, AFTER_FAILURE_S)
     try:
         return uploader.download()
     except LinkError:
