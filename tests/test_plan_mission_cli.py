@@ -203,3 +203,21 @@ def test_a_flight_beyond_the_endurance_is_split_into_sorties_that_each_fit(tmp_p
     assert all(s["flight_time_s"] <= 15 * 60 for s in summary["sorties"])
     assert [Path(f).name for f in summary["files"]] == [f"site-{k}.plan" for k in
                                                         range(1, len(summary["sorties"]) + 1)]
+
+
+def test_the_plot_shows_direction_visits_take_off_return_and_scale(tmp_path):
+    """SVG keeps its text as text, so what an operator reads can be checked: visit numbers,
+    take-off, the return, north and a scale bar, the legend; PDF by its extension."""
+    targets = tmp_path / "t.csv"
+    targets.write_text("lat,lon\n46.80,6.94\n46.81,6.95\n46.805,6.955\n46.79,6.96\n")
+    svg, pdf = tmp_path / "m.svg", tmp_path / "m.pdf"
+    for picture in (svg, pdf):
+        result = run(targets, "--radius", 80, "--airspeed", 22, "-o", tmp_path / "m.plan",
+                     "--plot", picture, "--time-limit", 0)
+        assert result.returncode == 0, result.stderr
+    text = svg.read_text()
+    for label in (">1<", ">4<", ">take-off<", ">N<", "return to home", "numbered in visiting order",
+                  "from take-off to the return"):
+        assert label in text, label
+    assert re.search(r">\d+ (m|km)<", text)                       # the scale bar
+    assert pdf.read_bytes()[:4] == b"%PDF"
