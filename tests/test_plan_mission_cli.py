@@ -194,13 +194,19 @@ def test_sanity_checks_refuse_or_warn_with_a_clear_message(tmp_path):
 
 
 def test_a_flight_beyond_the_endurance_is_split_into_sorties_that_each_fit(tmp_path):
+    rng = np.random.default_rng(3)
+    targets = tmp_path / "t.csv"
+    rows = [f"{46.8 + dy / 111_000:.6f},{6.95 + dx / 76_000:.6f}"
+            for dx, dy in rng.uniform(-2000, 2000, (30, 2))]
+    targets.write_text("lat,lon\n" + "\n".join(rows) + "\n")
     out = tmp_path / "site.plan"
-    result = run(SITE, "--radius", 80, "--airspeed", 22, "--endurance", 15, "-o", out,
-                 "--time-limit", 1, "--json", "-q")
+    result = run(targets, "--radius", 80, "--airspeed", 22, "--endurance", 12, "-o", out,
+                 "--time-limit", 0.2, "--json", "-q")
     assert result.returncode == 0, result.stderr
     summary = json.loads(result.stdout)
-    assert len(summary["sorties"]) >= 2 and sum(s["targets"] for s in summary["sorties"]) == 272
-    assert all(s["flight_time_s"] <= 15 * 60 for s in summary["sorties"])
+    assert summary["flight_time_s"] > 12 * 60            # as one mission it would not do
+    assert len(summary["sorties"]) >= 2 and sum(s["targets"] for s in summary["sorties"]) == 30
+    assert all(s["flight_time_s"] <= 12 * 60 for s in summary["sorties"])
     assert [Path(f).name for f in summary["files"]] == [f"site-{k}.plan" for k in
                                                         range(1, len(summary["sorties"]) + 1)]
 
