@@ -6,7 +6,6 @@ import sys
 import textwrap
 
 import numpy as np
-import pytest
 
 from conftest import environment_with_distribution
 from dtsp_mission.tour import tour_through_poses, tour_to_dict, write_tour

@@ -7,7 +7,6 @@ import sys
 from pathlib import Path
 
 import numpy as np
-import pytest
 from pymavlink import mavwp
 
 from conftest import assert_valid_tour

@@ -239,9 +239,10 @@ class PymavlinkUploader(Uploader):
                 return
             self.fresh_starts += 1
             if time.monotonic() >= deadline or attempts > MAX_FRESH_STARTS:
-                raise self._no_answer(f"{outcome}; {attempts} transfers started, the last one "
-                                      f"reached item {self._reached} of {count}, "
-                                      f"{time.monotonic() - deadline + self._budget(count):.0f} s in all")
+                started = f"{attempts} transfers started, the last one" if attempts > 1 else "it"
+                raise self._no_answer(f"{outcome}; {started} reached item {self._reached} of "
+                                      f"{count}, {time.monotonic() - deadline + self._budget(count):.0f} "
+                                      "s in all")
 
     def _budget(self, count: int) -> float:
         return self.timeout_s if self.timeout_s is not None else transfer_timeout_s(count)
