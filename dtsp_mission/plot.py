@@ -17,6 +17,7 @@ import numpy as np
 from .errors import InputError
 from .files import write_atomic
 from .mission import Command, Mission
+from .export.base import lengths_text
 from .mission.discretise import candidate_s
 from .tour import Tour
 
@@ -76,9 +77,7 @@ def draw_plan(product: Mission | Tour, path: str | os.PathLike,
         axes.fill(ring[:, 0], ring[:, 1], color="#e8f0e0", zorder=0, label="survey area")
     axes.plot(line[:, 0], line[:, 1], color="#1f5fa8", linewidth=0.8,
               # the two lengths plan reports, named and rounded as it prints them
-              label=f"flight: {mission.summary['flight_length_m'] / 1e3:,.2f} km from take-off "
-                    f"to the return (tour {tour.length_m:,.1f} m)" if mission
-              else f"tour {tour.length_m:,.1f} m", zorder=2)
+              label=lengths_text(mission) if mission else f"tour {tour.length_m:,.1f} m", zorder=2)
     # the direction of flight: an arrow every twelfth of the path
     arrows = chain.pose_at(np.linspace(0.0, chain.length_m, 13)[1:-1] if chain.length_m > 0
                            else np.zeros(0))

@@ -63,6 +63,18 @@ class WireItem:
                    _f32(z), int(mission_type))
 
 
+def wire_item_from(message, current: int | None = None) -> WireItem:
+    """The WireItem of a received MISSION_ITEM_INT or MISSION_ITEM (the old message with float
+    degrees, brought to 1e-7 degrees); ``current`` overrides the message's."""
+    x, y = message.x, message.y
+    if message.get_type() == "MISSION_ITEM":
+        x, y = round(x * 1e7), round(y * 1e7)
+    return WireItem.normalised(message.seq, message.frame, message.command,
+                               message.current if current is None else current,
+                               message.autocontinue, message.param1, message.param2,
+                               message.param3, message.param4, x, y, message.z, MISSION_TYPE_MISSION)
+
+
 # -- ArduPilot ---------------------------------------------------------------------------------
 
 #: Commands ArduPilot stores with a location, and commands it stores without one (these come

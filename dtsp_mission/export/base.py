@@ -19,6 +19,13 @@ from ..tour import Tour
 PATH_STEP_RAD = math.radians(2.0)
 
 
+def lengths_text(mission: Mission) -> str:
+    """The flight and the tour as ``plan`` reports them: 'flight: X km from take-off to the
+    return (tour Y m)'; for plots and documents, so every output names the same two lengths."""
+    return (f"flight: {mission.summary['flight_length_m'] / 1e3:,.2f} km from take-off to the "
+            f"return (tour {mission.tour.length_m:,.1f} m)")
+
+
 def flight_path_deg(mission: Mission, step_rad: float = PATH_STEP_RAD) -> tuple[np.ndarray, np.ndarray]:
     """Latitudes and longitudes (WGS84 degrees) of the flown path, sampled from its exact
     segments: every segment end, and arcs every ``step_rad`` of turn, so the polyline stays

@@ -18,6 +18,7 @@ import numpy as np
 from ..errors import DtspError, InputError, MissionTooLarge
 from ..frame import LocalFrame
 from ..targets import GeoTargets
+from ..targets.model import MAX_ALTITUDE_M
 from ..tour import Tour
 from ..vehicle import bearing_to_heading_rad, heading_to_bearing_deg
 from ..autopilot.commands import AUTOPILOTS, Command, Frame
@@ -40,11 +41,6 @@ RETURN_MODES = ("rtl", "land", "none")
 #: How waypoints are chosen: for the autopilot's guidance (predicted with the flight model),
 #: or as a polyline within a tolerance of the exact path.
 DESIGNS = ("guidance", "geometry")
-
-
-#: The highest altitude above home a mission may use: beyond it a number is far more likely a
-#: typo (or feet) than a fixed-wing survey.
-MAX_ALTITUDE_M = 10_000.0
 
 
 @dataclass(frozen=True)

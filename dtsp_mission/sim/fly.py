@@ -9,7 +9,6 @@ the flight time is the simulator's clock.
 from __future__ import annotations
 
 import math
-import socket
 import time
 from dataclasses import dataclass
 from typing import Callable
@@ -127,10 +126,6 @@ def _watch(vehicle: SimulatedVehicle, connection: str, mission: VehicleMission, 
     use_mavlink2()
     link = mavutil.mavlink_connection(connection, source_system=GCS_SYSTEM_ID,
                                       source_component=GCS_COMPONENT_ID)
-    try:   # at a high --speedup telemetry comes in bursts: room for them, so none is dropped
-        link.port.setsockopt(socket.SOL_SOCKET, socket.SO_RCVBUF, 8 << 20)
-    except (AttributeError, OSError):
-        pass
     rows = []
     highest = -1
     last_seq = len(vehicle.mission) - 1

@@ -22,7 +22,7 @@ import time
 from typing import Callable
 
 from ..autopilot import Autopilot
-from ..autopilot.storage import ACCEPTED, ERROR, MISSION_TYPE_MISSION, MissionStore, WireItem
+from ..autopilot.storage import ACCEPTED, ERROR, MISSION_TYPE_MISSION, MissionStore, wire_item_from
 
 MAV_MISSION_UNSUPPORTED = 3
 MAV_MISSION_INVALID_SEQUENCE = 13
@@ -141,13 +141,7 @@ class MissionServer:
             return
         if not self._before_item(message.seq):
             return
-        x, y = message.x, message.y
-        if message.get_type() == "MISSION_ITEM":        # float degrees: the old message
-            x, y = round(x * 1e7), round(y * 1e7)
-        item = WireItem.normalised(message.seq, message.frame, message.command, 0,
-                                   message.autocontinue, message.param1, message.param2,
-                                   message.param3, message.param4, x, y, message.z)
-        result = self.store.write(item)
+        result = self.store.write(wire_item_from(message, current=0))
         if result != ACCEPTED:
             self.store.abort()
             self.receiving = False

@@ -90,17 +90,22 @@ class GeoTargets:
                        altitudes_m=_pick(self.altitudes_m, keep), merged_duplicates=0)
 
 
+#: The highest altitude above home a target or mission may use: beyond it a number is far more
+#: likely a typo (or feet) than a fixed-wing survey.
+MAX_ALTITUDE_M = 10_000.0
+
+
 def check_altitudes(altitudes_m: np.ndarray | None, where: str) -> None:
     """Raise :class:`InputError` unless every altitude is a finite number above zero (or NaN:
     not given, the mission's altitude)."""
     if altitudes_m is None:
         return
     given = ~np.isnan(altitudes_m)
-    bad = given & (~np.isfinite(altitudes_m) | (altitudes_m <= 0.0) | (altitudes_m > 10_000.0))
+    bad = given & (~np.isfinite(altitudes_m) | (altitudes_m <= 0.0) | (altitudes_m > MAX_ALTITUDE_M))
     if bad.any():
         index = int(np.argmax(bad))
         raise InputError(f"{where}, target {index + 1}: altitude {float(altitudes_m[index])!r} m must be "
-                         "a number above 0 and at most 10,000 (metres above home)")
+                         f"a number above 0 and at most {MAX_ALTITUDE_M:,.0f} (metres above home)")
 
 
 def cluster_positions(positions: np.ndarray, resolution: float = 0.0) -> tuple[np.ndarray, np.ndarray]:

@@ -21,6 +21,7 @@ from .connection import check_host
 from .base import (MIN_TIMEOUT_S, TIMEOUT_S, VEHICLE_GIVES_UP_S, Progress, Uploader, VehicleInfo,
                    transfer_timeout_s)
 from .results import ITEM_RESULTS, NO_SPACE, result_text
+from ..autopilot.storage import wire_item_from
 from .wire import MISSION_TYPE_MISSION, WireItem
 
 GCS_SYSTEM_ID = 255
@@ -455,21 +456,11 @@ class PymavlinkUploader(Uploader):
             timer.settle()
             quiet = 0
             asked.pop(got, None)
-            items[got] = self._item_from(message)
+            items[got] = wire_item_from(message)
             if progress is not None:
                 progress(len(items), count, self.resent)
         self._link.mav.mission_ack_send(system, component, 0, MISSION_TYPE_MISSION)
         return [items[seq] for seq in range(count)]
-
-    @staticmethod
-    def _item_from(message) -> WireItem:
-        x, y = message.x, message.y
-        if message.get_type() == "MISSION_ITEM":     # float degrees: the old message
-            x, y = round(x * 1e7), round(y * 1e7)
-        return WireItem.normalised(message.seq, message.frame, message.command, message.current,
-                                   message.autocontinue, message.param1, message.param2,
-                                   message.param3, message.param4, x, y, message.z,
-                                   MISSION_TYPE_MISSION)
 
 class RetransmitTimer:
     """The retransmission timeout of a link, from its measured round trips (RFC 6298: smoothed

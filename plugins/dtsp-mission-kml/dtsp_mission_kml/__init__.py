@@ -21,6 +21,7 @@ import xml.etree.ElementTree as ET
 import numpy as np
 
 from dtsp_mission.export import Exporter, flight_path_deg
+from dtsp_mission.export.base import lengths_text
 from dtsp_mission.mission import Mission
 
 KML_NAMESPACE = "http://www.opengis.net/kml/2.2"
@@ -67,8 +68,7 @@ def kml_document(mission: Mission) -> ET.Element:
     tour = mission.tour
     _text(document, "name", f"dtsp-mission: {len(tour.targets_m)} targets, {tour.planner}")
     _text(document, "description",
-          f"flight: {mission.summary['flight_length_m'] / 1e3:,.2f} km from take-off to the "
-          f"return (tour {tour.length_m:,.1f} m: the closed Dubins tour for turn radius "
+          f"{lengths_text(mission)[:-1]}: the closed Dubins tour for turn radius "
           f"{mission.rho_m:g} m); {len(mission.items)} mission items; altitudes are above home.")
     _style(document, "path", PATH_COLOUR, 3.0)
     _style(document, "target", TARGET_COLOUR, None)
