@@ -79,7 +79,7 @@ def test_fly_command_reports_every_target(mission, tmp_path):
     result = run("fly", path, "--radius", 80, "--airspeed", 20, "--speedup", 400)
     assert result.exit_code == 0, result.output
     assert "simulated flight completed" in result.output
-    rows = re.findall(r"^item \d+\t([\d.]+)\t", result.output, re.M)
+    rows = re.findall(r"^target waypoint \d+ \(item \d+\)\t([\d.]+)\t", result.output, re.M)
     # A stock ArduPlane flies the chords of these waypoint missions 10-40 m off the targets
     # (the recorded SITL flights); the model predicts the same.
     assert len(rows) == 8 and max(map(float, rows)) <= 40.0
@@ -168,7 +168,7 @@ def test_a_site_too_big_for_the_vehicle_is_flown_as_sorties_it_accepts(tmp_path,
                      "--max-miss", 1000)
         assert result.exit_code == 0, result.output
         assert "simulated flight completed" in result.output
-        flown += len(re.findall(r"^item \d+\t([\d.]+)\t", result.output, re.M))
+        flown += len(re.findall(r"^target waypoint \d+ \(item \d+\)\t([\d.]+)\t", result.output, re.M))
     assert flown == 272                     # every target in exactly one sortie, each flown
 
 

@@ -116,10 +116,11 @@ def test_targets_files_as_people_have_them(tmp_path):
 
     from dtsp_mission.targets import read_targets
     semicolons = tmp_path / "s.csv"
-    semicolons.write_text("# exported from the site survey\nname;lat;lon;alt;camera\n"
-                          "A;46.80;6.94;;yes\n# a comment between rows\nB;46.81;6.95;120;no\n")
+    semicolons.write_text("# exported from the site survey\nname;lat;lon;alt;inspector;camera\n"
+                          "A;46.80;6.94;;Ann;yes\n# a comment between rows\nB;46.81;6.95;120;Bo;no\n")
     targets = read_targets(semicolons)
-    assert targets.names == ("A", "B") and targets.unused_columns == ("camera",)
+    assert targets.names == ("A", "B") and targets.unused_columns == ("inspector",)
+    assert targets.actions.photo.tolist() == [True, False]      # 'camera' is the photo action
     assert np.isnan(targets.altitudes_m[0]) and targets.altitudes_m[1] == 120.0
     tabs = tmp_path / "t.csv"
     tabs.write_text("lat\tlon\n46.80\t6.94\n46.81\t6.95\n")

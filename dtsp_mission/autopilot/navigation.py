@@ -41,7 +41,10 @@ SITL_TURN_EFFICIENCY = 0.73
 LOITER_EXIT_HEADING_RAD = math.radians(10.0)
 
 NAV_COMMANDS = {Command.NAV_WAYPOINT, Command.NAV_TAKEOFF, Command.NAV_LAND,
-                Command.NAV_RETURN_TO_LAUNCH, Command.NAV_LOITER_TURNS}
+                Command.NAV_RETURN_TO_LAUNCH, Command.NAV_LOITER_TURNS, Command.NAV_LOITER_TIME}
+#: ArduPilot's MAV_CMD_NAV_LAST: commands above it do not navigate (a DO_SET_ROI's location is
+#: where the camera looks, not where the aircraft goes).
+NAV_LAST = 95
 
 
 @dataclass(frozen=True)
@@ -131,7 +134,7 @@ def local_items(wire: list, frame, home_amsl_m: float) -> list[LocalItem]:
     home; items without a position get NaN coordinates."""
     items = []
     for item in wire:
-        if item.frame == Frame.MISSION or item.command in _NO_POSITION:
+        if item.frame == Frame.MISSION or item.command in _NO_POSITION or item.command > NAV_LAST:
             x = y = math.nan
         else:
             x, y = frame.to_local(np.array([item.x / 1e7]), np.array([item.y / 1e7]))[0]
@@ -310,9 +313,13 @@ class MissionFlight:
     def _step_loiter_turns(self, item: LocalItem, dt: float) -> None:
         """LOITER_TURNS: capture the circle, count the turns by the bearing to the centre,
         then, with the tangent exit (param4), leave when the course points at the next
-        waypoint; the next leg starts where it left (from the centre without it)."""
+        waypoint; the next leg starts where it left (from the centre without it).
+        LOITER_TIME: the same, for param1 seconds from the capture, on ArduPlane's own loiter
+        radius (it keeps only the sign of param3, the direction)."""
         s = self.state
-        radius = abs(item.params[2]) or self.airframe.loiter_radius_m
+        timed = item.command == Command.NAV_LOITER_TIME
+        radius = self.airframe.loiter_radius_m if timed else (abs(item.params[2])
+                                                             or self.airframe.loiter_radius_m)
         direction = -1 if item.params[2] < 0 else 1
         accel, on_circle = self._loiter_lateral_accel(item.x_m, item.y_m, radius, direction)
         self._fly(dt, accel, self._toward_alt(item.alt_m, dt))
@@ -321,16 +328,26 @@ class MissionFlight:
         if loiter is None:
             if not on_circle:
                 return
-            loiter = self._loiter = {"bearing": bearing, "turned": 0.0, "counted": False}
+            loiter = self._loiter = {"bearing": bearing, "turned": 0.0, "counted": False,
+                                     "since_s": s.time_s}
         loiter["turned"] += -direction * math.remainder(bearing - loiter["bearing"], 2 * math.pi)
         loiter["bearing"] = bearing
-        if loiter["turned"] < 2 * math.pi * max(item.params[0], 0.0):
+        if timed and s.time_s - loiter["since_s"] < max(item.params[0], 0.0):
+            return
+        if not timed and loiter["turned"] < 2 * math.pi * max(item.params[0], 0.0):
             return
         following = self._following()
         if item.params[3] > 0 and following is not None:
-            towards = math.atan2(following.y_m - s.y_m, following.x_m - s.x_m)
-            if abs(math.remainder(towards - s.heading_rad, 2 * math.pi)) > LOITER_EXIT_HEADING_RAD:
-                return
+            # ArduPlane's exit test: at once if the next waypoint lies inside the circle (the
+            # course could never point at it), else the course within 10 deg of it (20 deg
+            # if it lies within 5 % outside), 10 deg more for each circle flown.
+            offset = math.hypot(following.x_m - item.x_m, following.y_m - item.y_m)
+            if offset >= 0.99 * radius:
+                base = 2.0 if offset < 1.05 * radius else 1.0
+                tolerance = LOITER_EXIT_HEADING_RAD * (base + math.floor(loiter["turned"] / (2 * math.pi)))
+                towards = math.atan2(following.y_m - s.y_m, following.x_m - s.x_m)
+                if abs(math.remainder(towards - s.heading_rad, 2 * math.pi)) > tolerance:
+                    return
             self._complete((s.x_m, s.y_m, item.alt_m))
             return
         self._complete()
@@ -374,7 +391,7 @@ class MissionFlight:
         if item.command == Command.NAV_TAKEOFF:
             self._step_takeoff(item, dt)
             return
-        if item.command == Command.NAV_LOITER_TURNS:
+        if item.command in (Command.NAV_LOITER_TURNS, Command.NAV_LOITER_TIME):
             self._step_loiter_turns(item, dt)
             return
         if item.command == Command.NAV_RETURN_TO_LAUNCH:

@@ -81,8 +81,12 @@ def wire_item_from(message, current: int | None = None) -> WireItem:
 #: back in frame 0 with no position); any other command is compared as the wire carries it.
 _AP_LOCATION_COMMANDS = {Command.NAV_WAYPOINT, Command.NAV_LOITER_UNLIM, Command.NAV_LOITER_TURNS,
                          Command.NAV_LOITER_TIME, Command.NAV_LAND, Command.NAV_TAKEOFF,
-                         Command.DO_LAND_START}
-_AP_NO_LOCATION_COMMANDS = {Command.NAV_RETURN_TO_LAUNCH, Command.DO_CHANGE_SPEED}
+                         Command.DO_LAND_START, Command.DO_SET_ROI}
+_AP_NO_LOCATION_COMMANDS = {Command.NAV_RETURN_TO_LAUNCH, Command.DO_CHANGE_SPEED,
+                            Command.DO_MOUNT_CONTROL}
+#: Commands ArduPilot stores without a location but with MISSION_ITEM_INT's x and y as plain
+#: numbers (AP_Mission passes them through unscaled): they come back in frame 0 with x and y.
+_AP_RAW_XY_COMMANDS = {Command.DO_DIGICAM_CONTROL}
 #: The frames ArduPilot keeps as a flag: the ``_INT`` forms come back in their plain form.
 _AP_FRAMES = {Frame.GLOBAL_INT: Frame.GLOBAL, Frame.GLOBAL_RELATIVE_ALT_INT: Frame.GLOBAL_RELATIVE_ALT,
               Frame.GLOBAL_TERRAIN_ALT_INT: Frame.GLOBAL_TERRAIN_ALT}
@@ -118,6 +122,9 @@ def _ardupilot(item: WireItem) -> WireItem:
     command = item.command
     if command in _AP_NO_LOCATION_COMMANDS:
         return replace(item, frame=int(Frame.GLOBAL), **_ap_params(item), x=0, y=0, z=0.0)
+    if command in _AP_RAW_XY_COMMANDS:
+        return replace(item, frame=int(Frame.GLOBAL), **_ap_params(item), x=_byte(item.x),
+                       y=_byte(item.y), z=0.0)
     if command not in _AP_LOCATION_COMMANDS:
         return item
     frame = int(_AP_FRAMES.get(item.frame, item.frame))
@@ -143,6 +150,15 @@ def _ap_params(item: WireItem) -> dict[str, float]:
         return dict(param1=0.0, param2=0.0, param3=0.0, param4=0.0)
     if command == Command.DO_CHANGE_SPEED:   # speed type in a byte, speed and throttle as floats
         return dict(param1=float(_byte(p1)), param2=_f32(p2), param3=_f32(p3), param4=0.0)
+    if command == Command.DO_SET_ROI:        # the ROI mode in 16 bits; the location is the ROI
+        return dict(param1=float(min(max(math.trunc(p1), 0), 65535)) if math.isfinite(p1) else 0.0,
+                    param2=0.0, param3=0.0, param4=0.0)
+    if command == Command.DO_MOUNT_CONTROL:  # pitch, roll, yaw as floats; the mode is not kept
+        return dict(param1=_f32(p1), param2=_f32(p2), param3=_f32(p3), param4=0.0)
+    if command == Command.DO_DIGICAM_CONTROL:    # session, zoom, zoom step, focus in bytes
+        step = int(min(max(math.trunc(p3), -128), 127)) if math.isfinite(p3) else 0
+        return dict(param1=float(_byte(p1)), param2=float(_byte(p2)), param3=float(step),
+                    param4=float(_byte(p4)))
     return dict(param1=_f32(p1), param2=_f32(p2), param3=_f32(p3), param4=_f32(p4))
 
 

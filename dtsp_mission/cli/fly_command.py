@@ -6,10 +6,11 @@ from __future__ import annotations
 import click
 import numpy as np
 
-from ..sim.fly import FlightCheck, fly_mission, targets_in
+from ..sim.fly import FlightCheck, fly_mission, targets_from, targets_in
 from . import console
-from .console import console_options, record, say
-from .options import apply, progress_reporter, reports_errors, simulation_options, vehicle_options
+from .console import console_options, note, record, say
+from .options import (UserError, apply, progress_reporter, reports_errors, simulation_options,
+                      vehicle_options)
 from .sim_command import airframe_from
 
 
@@ -65,14 +66,20 @@ def print_check(check: FlightCheck) -> None:
               help="Exit with status 1 if any target is missed by more than this.")
 @click.option("--max-items", type=int, metavar="N", help="Mission slots of the simulated "
               "vehicle (default: a stock vehicle's, ArduPlane 655, PX4 500).")
+@click.option("--targets", "targets_file", type=click.Path(dir_okay=False), metavar="FILE",
+              help="Measure the misses to these targets (the file the mission was planned "
+                   "from), named as in it; default: to the target waypoints in the mission.")
 @apply(console_options)
 @reports_errors
 def fly(mission_file, rho_m, airspeed_m_s, max_bank_deg, speedup, vehicle_params_file,
-        l1_period_s, via, format_name, max_miss_m, max_items, quiet, as_json) -> None:
+        l1_period_s, via, format_name, max_miss_m, max_items, targets_file, quiet,
+        as_json) -> None:
     """Upload MISSION_FILE to the simulated fixed wing, fly it, and print per-target miss
     distances and the flight time.
 
-    The targets are the waypoints with an acceptance radius (how dtsp-mission writes them).
+    The targets are those of --targets FILE, or else the waypoints with an acceptance radius
+    (how dtsp-mission writes the targets' waypoints; the guidance design aims them off the
+    targets, so give --targets to measure what matters).
     The aircraft navigates like an ArduPlane with --vehicle-params (a stock one without);
     --radius or --max-bank limit its bank, --airspeed sets its cruise speed.
 
@@ -84,6 +91,21 @@ def fly(mission_file, rho_m, airspeed_m_s, max_bank_deg, speedup, vehicle_params
     airframe, _, _ = airframe_from(vehicle_params_file, airspeed_m_s, max_bank_deg, l1_period_s,
                                    rho_m)
     try:
-        run_flight_check(mission, targets_in(mission), airframe, via, speedup, max_miss_m, max_items)
+        if targets_file is None:
+            targets = targets_in(mission)
+            note("misses are measured to the target waypoints of the file (the guidance design "
+                 "aims them off the targets): give --targets FILE to measure to the targets")
+        else:
+            targets = targets_from(read_geodetic_targets(targets_file))
+        run_flight_check(mission, targets, airframe, via, speedup, max_miss_m, max_items)
     finally:
         console.finish()       # the summary also when --max-miss fails the check
+
+
+def read_geodetic_targets(path):
+    """The targets of a targets file, in degrees (UserError for local x/y metres)."""
+    from ..targets import GeoTargets, read_targets
+    targets = read_targets(path)
+    if not isinstance(targets, GeoTargets):
+        raise UserError(f"{path}: the targets are local x/y metres; --targets needs lat/lon")
+    return targets

@@ -109,13 +109,15 @@ mission_options = [
 
 def mission_settings(autopilot, altitude_m, airspeed_m_s, home_deg, home_amsl_m,
                      launch_bearing_deg, landing_bearing_deg, return_mode, design, max_miss_m,
-                     tolerance_m, max_items, vehicle=None):
+                     tolerance_m, max_items, vehicle=None, **actions):
     """The :class:`MissionSettings` of the :data:`mission_options` values (``vehicle``: the
-    :class:`~dtsp_mission.autopilot.parameters.VehicleParameters` the mission is for)."""
+    :class:`~dtsp_mission.autopilot.parameters.VehicleParameters` the mission is for;
+    ``actions``: photo, roi, gimbal_pitch_deg, loiter_radius_m)."""
     from ..mission import MissionSettings
     return MissionSettings(autopilot, altitude_m, airspeed_m_s, home_deg, home_amsl_m,
                            launch_bearing_deg, landing_bearing_deg, return_mode, tolerance_m,
-                           max_items, design=design, max_miss_m=max_miss_m, vehicle=vehicle)
+                           max_items, design=design, max_miss_m=max_miss_m, vehicle=vehicle,
+                           **actions)
 
 
 def apply(options: list) -> Callable:

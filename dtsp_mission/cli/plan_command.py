@@ -3,27 +3,25 @@
 from __future__ import annotations
 
 import os
-import time
+from dataclasses import replace
 from pathlib import Path
 
 import click
 import numpy as np
-import shapely
 
-from ..api import local_frame_for
-from ..errors import MissionTooLarge
+from ..dubins.path import check_radius
 from ..export import exporter_for
 from ..files import write_atomic
-from ..frame import LocalFrame
-from ..mission import Autopilot, Mission, MissionSettings, build_mission
-from ..mission.build import targets_beyond, with_turn_margin
-from ..mission.sorties import sortie_path, split_into_sorties
-from ..planning import TilingUnavailable, get_planner, planners
+from ..mission import Autopilot, MissionSettings
+from ..mission.build import targets_beyond
+from ..mission.sorties import sortie_path
+from ..pipeline import PlanRequest, PlanResult, run_plan
+from ..planning import planners
 from ..planning.base import MERGE_RESOLUTION_RHO
-from ..planning.lower_bounds import lower_bound
 from ..planning.rbta import region_heading_deg
 from ..plot import draw_plan, plot_format, require_matplotlib
 from ..targets import GeoTargets, Targets, random_targets, read_targets
+from ..targets.actions import TargetActions, check_loiter_turns
 from ..targets.geojson_file import read_geojson
 from . import console
 from .console import console_options, note, record, say
@@ -79,22 +77,6 @@ def _area(area_file: str) -> np.ndarray:
     return area
 
 
-def _frame(targets: GeoTargets | Targets, origin) -> tuple[Targets, GeoTargets | None, LocalFrame | None]:
-    """Local targets, their degrees and the frame (the last two None for local-only input)."""
-    if isinstance(targets, GeoTargets):
-        if origin is not None:
-            raise UserError("--origin is for targets in local x/y metres; these are in lat/lon")
-        # The readers checked the coordinates; in_frame checks that they fit the frame.
-        frame, local = local_frame_for(targets)
-        return local, targets, frame
-    if origin is None:
-        return targets, None, None
-    frame = LocalFrame(*origin)
-    geodetic = targets.to_geodetic(frame)
-    frame.check_extent(geodetic.latitudes_deg, geodetic.longitudes_deg)
-    return targets, geodetic, frame
-
-
 def _duration(seconds: float) -> str:
     minutes = int(round(seconds / 60))
     return f"{minutes // 60} h {minutes % 60:02d} min" if minutes >= 60 else f"{seconds / 60:.1f} min"
@@ -138,6 +120,21 @@ def _duration(seconds: float) -> str:
 @click.option("--endurance", "endurance_min", type=click.FloatRange(min=0.0, min_open=True),
               metavar="MINUTES", help="Longest flight the aircraft can make (take-off to the "
               "return, at --airspeed): a longer mission is split into sorties that each fit.")
+@click.option("--photo", is_flag=True, help="Take a picture at every target when it is overflown "
+              "(ArduPilot DO_DIGICAM_CONTROL, PX4 IMAGE_START_CAPTURE); a 'photo' column "
+              "chooses targets.")
+@click.option("--roi", is_flag=True, help="Point the camera at each target from the previous one "
+              "on (DO_SET_ROI / DO_SET_ROI_LOCATION), off after the last; a 'roi' column chooses "
+              "targets.")
+@click.option("--gimbal-pitch", "gimbal_pitch_deg", type=float, metavar="DEG",
+              help="Gimbal pitch for targets without a 'gimbal_pitch' of their own (-90 looks "
+                   "straight down; DO_MOUNT_CONTROL / DO_GIMBAL_MANAGER_PITCHYAW).")
+@click.option("--loiter", "loiter_specs", multiple=True, metavar="TARGET[:TURNS]",
+              help="Circle this target (a name from the file or a 1-based number) TURNS whole "
+                   "times (default 1) before going on: circles through the target, tangent to "
+                   "the tour. Repeatable; a 'loiter_turns' column does the same.")
+@click.option("--loiter-radius", "loiter_radius_m", type=float, metavar="METRES",
+              help="Radius of the loiter circles (default 1.3 x the turn radius).")
 @click.option("--simulate", is_flag=True, help="Fly the mission in the simulator (an ArduPlane "
               "with --vehicle-params, stock without) and print per-target miss distances.")
 @apply(simulation_options)
@@ -148,12 +145,14 @@ def plan(targets_file, random_count, area_file, seed, origin, rho_m, airspeed_m_
          return_mode, design, max_miss_m, tolerance_m, max_items, algorithm, region, time_limit_s,
          fallback, outputs, format_name,
          plot_file, connection, via, verify, signing_key_file, transfer_timeout_s, endurance_min,
-         simulate, speedup,
+         photo, roi, gimbal_pitch_deg, loiter_specs, loiter_radius_m, simulate, speedup,
          vehicle_params_file, l1_period_s, quiet, as_json) -> None:
     """Plan a Dubins tour through the targets and write it as a mission.
 
     TARGETS_FILE: CSV with lat,lon columns (optional alt, name), or local x,y metres (with
     --origin to place them), or GeoJSON Point features (a Polygon feature is the survey area).
+    Optional columns (or properties) photo, roi, gimbal_pitch and loiter_turns set the actions
+    at each target, written in the forms ArduPilot and PX4 each accept.
 
     Example: dtsp-mission plan examples/site-inspection.csv --radius 80 --alt 120 -o mission.plan
     """
@@ -172,6 +171,7 @@ def plan(targets_file, random_count, area_file, seed, origin, rho_m, airspeed_m_
     designed_for = _designed_for(vehicle_params_file)
     rho, rho_source = turn_radius_from(rho_m, airspeed_m_s, max_bank_deg,
                                        designed_for.ROLL_LIMIT_DEG if designed_for else None)
+    check_radius(rho)
     targets = _targets(targets_file, random_count, area_file, seed)
     if len(targets) < 2:
         raise UserError(f"{targets_file or 'the input'} holds {len(targets)} target(s) after "
@@ -179,93 +179,59 @@ def plan(targets_file, random_count, area_file, seed, origin, rho_m, airspeed_m_
                         "single waypoint)")
     if targets.unused_columns:
         note(f"{targets_file}: columns not used: {', '.join(targets.unused_columns)} (the "
-             "columns read are lat/lon or x/y, alt and name)")
-    local, geodetic, frame = _frame(targets, origin)
+             "columns read are lat/lon or x/y, alt, name, photo, roi, gimbal_pitch and "
+             "loiter_turns)")
+    if loiter_specs:
+        targets = with_loiters(targets, loiter_specs)
+    if isinstance(targets, GeoTargets) and origin is not None:
+        raise UserError("--origin is for targets in local x/y metres; these are in lat/lon")
+    geographic = isinstance(targets, GeoTargets) or origin is not None
     needs_mission = [output for output, writer in writers if writer.needs_mission]
-    if needs_mission and frame is None:
+    if needs_mission and not geographic:
         raise UserError(f"{needs_mission[0]}: a mission needs targets in degrees; these are "
                         "local x/y metres, so give --origin LAT,LON (or write only a .json tour)")
-    if local.merged_duplicates:
-        note(f"{local.merged_duplicates} duplicate targets merged ({len(local)} remain)")
-    area_m = None
-    if geodetic is not None and geodetic.area_deg is not None:
-        area_m = frame.to_local(geodetic.area_deg[:, 0], geodetic.area_deg[:, 1])
-        outside = int((~shapely.contains_xy(shapely.Polygon(area_m), *local.positions_m.T)).sum())
-        if outside:
-            note(f"{outside} targets lie outside the survey area")
-    say(f"{len(local)} targets; {rho_source}")
-    record(targets=len(local), rho_m=rho)
-
+    if (connection or simulate) and not geographic:
+        raise UserError("--upload and --simulate need a mission in degrees: targets in lat/lon, "
+                        "or local x/y with --origin")
+    settings = None
+    if geographic:
+        settings = mission_settings(autopilot, altitude_m, airspeed_m_s, home_deg, home_amsl_m,
+                                    launch_bearing_deg, landing_bearing_deg, return_mode, design,
+                                    max_miss_m, tolerance_m, max_items, designed_for,
+                                    photo=photo, roi=roi, gimbal_pitch_deg=gimbal_pitch_deg,
+                                    loiter_radius_m=loiter_radius_m)
+        settings.checked(rho)          # refused before planning, not after
+        if autopilot == "px4" and any(writer.name == "waypoints" for _, writer in writers):
+            note("a .waypoints file holds the home in its row 0, as QGroundControl, Mission "
+                 "Planner and MAVProxy read it; a tool that sends every row would make it PX4's "
+                 "first item: load it in QGroundControl or send it with `dtsp-mission upload` "
+                 "(both leave row 0 out for PX4), or write a .plan")
     parameters = {"region": region} if algorithm in ("rbta", "auto") else {}
     if algorithm == "auto":
         parameters.update(time_limit_s=time_limit_s, seed=seed)
+    request = PlanRequest(targets, rho, algorithm, parameters, fallback, origin, settings,
+                          too_large="split" if (needs_mission or connection or simulate) else "note",
+                          endurance_s=endurance_min and endurance_min * 60)
     from ..compiled import kernels_cached
     if not kernels_cached():
         note("first run on this machine: compiling the planning kernels (about a minute, "
              "once; later runs start at once)")
-    started = time.perf_counter()
+    say(f"{len(targets)} targets; {rho_source}")
     progress, close_progress = progress_reporter("improving the tour")
     try:
-        planner = get_planner(algorithm, **parameters)
-        if algorithm == "auto":
-            planner.progress = lambda fraction: progress(int(1000 * fraction), 1000)
-        tour = planner.plan(local.positions_m, rho)
-    except TilingUnavailable as error:
-        if not fallback:
-            raise
-        note(f"{error}; planning with the Alternating Algorithm instead")
-        tour = get_planner("alternating").plan(local.positions_m, rho)
+        result = run_plan(request, lambda fraction: progress(int(1000 * fraction), 1000))
     finally:
         close_progress()
-    elapsed = time.perf_counter() - started
-    _report_tour(tour, local.positions_m, area_m, elapsed)
-
-    product = tour
-    sorties = []
-    if frame is not None:
-        settings = mission_settings(autopilot, altitude_m, airspeed_m_s, home_deg, home_amsl_m,
-                                    launch_bearing_deg, landing_bearing_deg, return_mode, design,
-                                    max_miss_m, tolerance_m, max_items,
-                                    _designed_for(vehicle_params_file))
-        try:
-            product = build_mission(tour, frame, geodetic, settings)
-        except MissionTooLarge as error:
-            if not (any(writer.needs_mission for _, writer in writers) or connection or simulate):
-                # Only the tour is asked for: the vehicle's storage does not limit it.
-                note(f"as one mission this would not fit the vehicle: {error}")
-            else:
-                sorties = _split(tour, frame, geodetic, settings,
-                                 f"as one mission it needs {error.needed} items (at least) but "
-                                 f"the vehicle holds {error.capacity} (--max-items)",
-                                 endurance_min and endurance_min * 60)
-        if isinstance(product, Mission) and "predicted_miss_m" in product.summary:
-            planner = get_planner(algorithm, **parameters)
-            widened = with_turn_margin(product, lambda r: planner.plan(local.positions_m, r),
-                                       geodetic, settings)
-            if widened is not product:
-                note(f"planned with a turn radius of {widened.rho_m:g} m instead of "
-                           f"{rho:g} m so that the autopilot's guidance can hold the turns: "
-                           f"{targets_beyond(product, max_miss_m)} -> "
-                           f"{targets_beyond(widened, max_miss_m)} targets predicted beyond "
-                           "--max-miss")
-                product, tour = widened, widened.tour
-        if isinstance(product, Mission):
-            _report_mission(product)
-            flight_s = product.summary.get("flight_time_s", 0.0)
-            if endurance_min is not None and flight_s > endurance_min * 60:
-                sorties = _split(tour, frame, geodetic, settings,
-                                 f"the flight takes {flight_s / 60:.1f} min, more than the "
-                                 f"endurance of {endurance_min:g} min (--endurance)",
-                                 endurance_min * 60)
-            _warn_far_home(product, local.positions_m, frame)
-    elif airspeed_m_s:
-        say(f"flight time of the tour at {airspeed_m_s:g} m/s: "
-                   f"{_duration(tour.length_m / airspeed_m_s)}")
+    record(targets=len(result.local), rho_m=rho)
+    _report(result, settings, airspeed_m_s)
+    product = result.product
+    sorties = result.sorties
     if sorties and connection:
         raise UserError(f"the mission is split into {len(sorties)} sorties (one file each); "
                         "upload them one at a time with `dtsp-mission upload FILE`")
     # All or nothing: every file is rendered before the first is written.
     rendered = []
+    frame = result.frame
     for output, writer in writers:
         if sorties and writer.needs_mission:
             rendered += [(sortie_path(output, k + 1), writer,
@@ -278,12 +244,9 @@ def plan(targets_file, random_count, area_file, seed, origin, rho_m, airspeed_m_
         say(f"wrote {output} ({writer.description})")
         console.current().summary.setdefault("files", []).append(str(output))
     if plot_file:
-        draw_plan(product, plot_file, area_m)
+        draw_plan(product, plot_file, result.area_m)
         say(f"wrote {plot_file} (plot)")
         record(plot=str(plot_file))
-    if (connection or simulate) and frame is None:
-        raise UserError("--upload and --simulate need a mission in degrees: targets in lat/lon, "
-                        "or local x/y with --origin")
     if simulate:
         from ..sim.fly import planned_targets
         from .fly_command import run_flight_check
@@ -298,35 +261,71 @@ def plan(targets_file, random_count, area_file, seed, origin, rho_m, airspeed_m_
     if connection:
         from .upload_command import run_upload
         run_upload(product.for_vehicle(), connection, via, verify, signing_key_file,
-                   designed_for=_designed_for(vehicle_params_file),
-                   transfer_timeout_s=transfer_timeout_s)
+                   designed_for=designed_for, transfer_timeout_s=transfer_timeout_s)
     console.finish()
 
 
-def _split(tour, frame, geodetic, settings, reason: str, endurance_s: float | None = None):
-    """The sorties of a mission too large or too long for the vehicle, printed."""
-    home_m = (frame.to_local(*settings.home_deg)[0] if settings.home_deg is not None
-              else np.zeros(2))
-    sorties = split_into_sorties(tour, frame, geodetic, settings, home_m, endurance_s)
+def with_loiters(targets, specs: tuple[str, ...]):
+    """The targets with ``--loiter TARGET[:TURNS]`` applied: TARGET a name from the targets
+    file or a 1-based number, TURNS whole circles (default 1)."""
+    names = targets.names or ()
+    turns: dict[int, int] = {}
+    for spec in specs:
+        label, _, count = spec.rpartition(":") if ":" in spec else (spec, "", "1")
+        index = _target_index(label.strip(), names, len(targets))
+        try:
+            turns[index] = check_loiter_turns(float(count), f"--loiter {spec}")
+        except ValueError:
+            raise UserError(f"--loiter {spec}: TURNS must be a whole number, got {count!r}") from None
+    base = targets.actions if targets.actions is not None else TargetActions.none(len(targets))
+    return replace(targets, actions=base.with_options(loiter_turns=turns))
+
+
+def _target_index(label: str, names: tuple[str, ...], count: int) -> int:
+    if label in names:
+        return names.index(label)
+    if label.isdigit() and 1 <= int(label) <= count:
+        return int(label) - 1
+    known = f" or a name from the file (e.g. {names[0]})" if names else ""
+    raise UserError(f"--loiter {label!r}: no such target; give a number from 1 to {count}{known}")
+
+
+def _report(result: PlanResult, settings: MissionSettings | None,
+            airspeed_m_s: float | None) -> None:
+    """What the plan did, on the console (and in the --json summary)."""
+    _report_tour(result)
+    for text in result.notes:
+        note(text)
+    if result.mission is not None:
+        _report_mission(result.mission)
+        _warn_far_home(result.mission, result.local.positions_m, result.frame)
+    elif settings is None and airspeed_m_s:
+        say(f"flight time of the tour at {airspeed_m_s:g} m/s: "
+            f"{_duration(result.tour.length_m / airspeed_m_s)}")
+    if result.sorties:
+        _report_sorties(result, settings.max_miss_m)
+
+
+def _report_sorties(result: PlanResult, max_miss_m: float) -> None:
+    """The sorties of a mission too large or too long for the vehicle."""
+    sorties = result.sorties
     record(sorties=[{"targets": len(s.targets), "items": s.mission.summary["items"],
                      "flight_length_m": s.mission.summary["flight_length_m"],
                      "flight_time_s": s.mission.summary.get("flight_time_s")} for s in sorties])
-    say(f"{reason}: split into {len(sorties)} sorties, each a take-off, a contiguous part of "
-        "the tour and the return, balanced by flight time:")
-    names = geodetic.names
+    say(f"{result.split_reason}: split into {len(sorties)} sorties, each a take-off, a contiguous "
+        "part of the tour and the return, balanced by flight time:")
+    names = result.geodetic.names
     for k, sortie in enumerate(sorties):
         summary = sortie.mission.summary
         first, last = sortie.targets[0], sortie.targets[-1]
         label = (lambda i: names[i] if names else f"target {i + 1}")
         time_text = (f", {_duration(summary['flight_time_s'])}" if "flight_time_s" in summary
                      else "")
-        beyond = targets_beyond(sortie.mission, settings.max_miss_m) \
-            if "predicted_miss_m" in summary else 0
+        beyond = targets_beyond(sortie.mission, max_miss_m)
         say(f"  sortie {k + 1}: {len(sortie.targets)} targets ({label(first)} .. "
-                   f"{label(last)}), {summary['items']} items, "
-                   f"{summary['flight_length_m'] / 1e3:,.2f} km{time_text}"
-                   + (f", {beyond} predicted beyond --max-miss" if beyond else ""))
-    return sorties
+            f"{label(last)}), {summary['items']} items, "
+            f"{summary['flight_length_m'] / 1e3:,.2f} km{time_text}"
+            + (f", {beyond} predicted beyond --max-miss" if beyond else ""))
 
 
 #: A home farther than this from every target is worth a second look.
@@ -352,12 +351,8 @@ def _designed_for(vehicle_params_file):
     return read_parameters(vehicle_params_file)
 
 
-def _report_tour(tour, positions: np.ndarray, area_m: np.ndarray | None, elapsed: float) -> None:
-    if area_m is not None:
-        area = float(shapely.Polygon(area_m).area)
-    else:
-        area = max(float(np.ptp(positions[:, 0]) * np.ptp(positions[:, 1])), 1.0)
-    bound = lower_bound(positions, tour.rho_m, area)
+def _report_tour(result: PlanResult) -> None:
+    tour, bound, elapsed = result.tour, result.bound, result.planning_s
     say(f"planner {tour.planner}: tour {tour.length_m:,.1f} m ({elapsed:.2f} s)")
     record(planner=tour.planner, tour_length_m=tour.length_m, planning_s=elapsed,
            lower_bound_m=bound.one_tree_m)
@@ -408,6 +403,10 @@ def _report_mission(mission) -> None:
     if "predicted_miss_m" in summary:
         record(predicted_miss_m=summary["predicted_miss_m"],
                predicted_flight_m=summary["predicted_flight_m"])
+    if "actions" in summary:
+        say("  actions at the targets: " + ", ".join(f"{count} {role}" for role, count in
+                                                      summary["actions"].items()))
+        record(actions=summary["actions"])
     line = f"flight: {summary['flight_length_m'] / 1e3:,.2f} km from take-off to the return"
     if "flight_time_s" in summary:
         line += f", {_duration(summary['flight_time_s'])} at {mission.cruise_speed_m_s:g} m/s"

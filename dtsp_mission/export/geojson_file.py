@@ -76,9 +76,10 @@ def geojson_dict(mission: Mission) -> dict:
             properties["name"] = mission.target_names[target]
         features.append(_point(latitudes[target], longitudes[target], properties))
     for index, item in enumerate(mission.items):
-        if item.has_position:
+        if item.has_position and item.role != "roi_off":     # ArduPilot's "no ROI" is at 0, 0
+            kind = {"roi": "roi", "loiter": "loiter"}.get(item.role, "waypoint")
             features.append(_point(item.latitude_deg, item.longitude_deg,
-                                   {"kind": "waypoint", "item": index + 1, "command": int(item.command),
+                                   {"kind": kind, "item": index + 1, "command": int(item.command),
                                     "role": item.role, "altitude_m": item.altitude_m}))
     return {"type": "FeatureCollection", "features": features}
 

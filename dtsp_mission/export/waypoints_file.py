@@ -58,8 +58,9 @@ class WaypointsExporter(Exporter):
     readable = True
 
     def read(self, path) -> VehicleMission:
-        """Line 0 is home; the format does not say the autopilot, so it is ArduPilot (the
-        format of Mission Planner and MAVProxy)."""
+        """Line 0 is home (as QGroundControl, Mission Planner and MAVProxy read it, for every
+        autopilot); the format does not say the autopilot, so the mission is ArduPilot's (the
+        format's origin) until an uploader learns the vehicle's (``autopilot_stated`` False)."""
         lines = [line for line in read_text(path).splitlines() if line.strip()]
         if not lines or lines[0].strip() != HEADER:
             raise FileFormatError(f"{path}: not a QGC WPL 110 file (the first line must be {HEADER!r})")
@@ -80,4 +81,5 @@ class WaypointsExporter(Exporter):
         home = rows[0]
         items = tuple(MissionItem(int(r[3]), int(r[2]), tuple(r[4:8]), r[8], r[9], r[10], bool(r[11]))
                       for r in rows[1:])
-        return VehicleMission(items, Home(home[8], home[9], home[10]), Autopilot.ARDUPILOTMEGA)
+        return VehicleMission(items, Home(home[8], home[9], home[10]), Autopilot.ARDUPILOTMEGA,
+                              autopilot_stated=False)

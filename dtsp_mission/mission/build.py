@@ -18,6 +18,7 @@ import numpy as np
 from ..errors import DtspError, InputError, MissionTooLarge
 from ..frame import LocalFrame
 from ..targets import GeoTargets
+from ..targets.actions import TargetActions, check_gimbal_pitch
 from ..targets.model import MAX_ALTITUDE_M
 from ..tour import Tour
 from ..vehicle import bearing_to_heading_rad, heading_to_bearing_deg
@@ -25,6 +26,7 @@ from ..autopilot.commands import AUTOPILOTS, Command, Frame
 from ..autopilot.navigation import Airframe
 from ..autopilot.parameters import ARDUPLANE_DEFAULTS, VehicleParameters
 from ..autopilot.storage import MAVLINK_MAX_ITEMS, capacity
+from . import actions as action_items
 from .guidance import GuidanceDesign, design_waypoints
 from .discretise import waypoint_s
 from .flight_path import TAKEOFF_CLIMB_DEG, climb_distance_m, plan_flight_path
@@ -62,6 +64,10 @@ class MissionSettings:
     design: str = "geometry"                  # guidance | geometry (see DESIGNS)
     max_miss_m: float = 5.0                   # guidance: the predicted miss every target must hold
     vehicle: VehicleParameters | None = None  # guidance: the autopilot's parameters (stock if None)
+    photo: bool = False                       # a picture at every target
+    roi: bool = False                         # the camera pointed at every target
+    gimbal_pitch_deg: float | None = None     # gimbal pitch for targets without their own
+    loiter_radius_m: float | None = None      # default actions.LOITER_RADIUS_RHO * rho
 
     def checked(self, rho_m: float) -> "MissionSettings":
         """The settings with defaults filled in, or :class:`InputError` saying what is wrong."""
@@ -97,6 +103,13 @@ class MissionSettings:
         if not (math.isfinite(self.home_altitude_amsl_m) and abs(self.home_altitude_amsl_m) < 1e4):
             raise InputError(f"home altitude must be a number of metres above sea level, got "
                              f"{self.home_altitude_amsl_m!r}")
+        if self.gimbal_pitch_deg is not None:
+            check_gimbal_pitch(self.gimbal_pitch_deg, "gimbal_pitch_deg (--gimbal-pitch)")
+        if self.loiter_radius_m is not None and not (math.isfinite(self.loiter_radius_m)
+                                                     and rho_m <= self.loiter_radius_m <= 2550.0):
+            raise InputError(f"loiter_radius_m (--loiter-radius) must be from the turn radius "
+                             f"({rho_m:g} m) to 2,550 m (the most ArduPilot stores), got "
+                             f"{self.loiter_radius_m!r}")
         for name in ("launch_bearing_deg", "landing_bearing_deg"):
             value = getattr(self, name)
             if value is not None and not math.isfinite(value):
@@ -105,24 +118,33 @@ class MissionSettings:
         return replace(self, return_mode=return_mode, tolerance_m=tolerance, max_items=max_items)
 
 
-def _fixed_items(settings: MissionSettings) -> int:
-    """Items that are not waypoints on the path (takeoff, speed, return; ArduPilot's home)."""
-    return (1 + (settings.airspeed_m_s is not None)
+def _fixed_items(settings: MissionSettings, actions: int = 0) -> int:
+    """Items that are not waypoints on the path (takeoff, speed, return; ArduPilot's home;
+    the ``actions`` at the targets)."""
+    return (actions + 1 + (settings.airspeed_m_s is not None)
             + {"rtl": 1, "land": 2, "none": 0}[settings.return_mode]
             + (settings.autopilot == "ardupilot"))
 
 
-def _fit_waypoints(path: FlightPath, rho_m: float, settings: MissionSettings) -> tuple[np.ndarray, float]:
+def _path_waypoints(path: FlightPath, rho_m: float, tolerance_m: float) -> np.ndarray:
+    """Waypoint arc lengths within ``tolerance_m`` of the path, none on a loiter's circles (a
+    loiter item flies them)."""
+    chosen = waypoint_s(path.chain, rho_m, path.target_s_m, tolerance_m)
+    return chosen[~path.in_loiter(chosen)] if path.loiters else chosen
+
+
+def _fit_waypoints(path: FlightPath, rho_m: float, settings: MissionSettings,
+                   actions: int = 0) -> tuple[np.ndarray, float]:
     """Waypoint arc lengths at the finest tolerance in [preferred, tolerance] that fits the
     item budget, and that tolerance."""
-    budget = settings.max_items - _fixed_items(settings) + 1   # the takeoff point is free
+    budget = settings.max_items - _fixed_items(settings, actions) + 1   # the takeoff point is free
     fine = PREFERRED_TOLERANCE_FRACTION * settings.tolerance_m
-    chosen = waypoint_s(path.chain, rho_m, path.target_s_m, fine)
+    chosen = _path_waypoints(path, rho_m, fine)
     if len(chosen) <= budget:
         return chosen, fine
-    coarse = waypoint_s(path.chain, rho_m, path.target_s_m, settings.tolerance_m)
+    coarse = _path_waypoints(path, rho_m, settings.tolerance_m)
     if len(coarse) > budget:
-        needed = len(coarse) - 1 + _fixed_items(settings)
+        needed = len(coarse) - 1 + _fixed_items(settings, actions)
         raise MissionTooLarge(
             f"the mission needs {needed} items at a waypoint tolerance of "
             f"{settings.tolerance_m:.3g} m but the vehicle holds {settings.max_items} "
@@ -132,7 +154,7 @@ def _fit_waypoints(path: FlightPath, rho_m: float, settings: MissionSettings) ->
     low, high, chosen = fine, settings.tolerance_m, coarse
     for _ in range(12):
         middle = math.sqrt(low * high)
-        attempt = waypoint_s(path.chain, rho_m, path.target_s_m, middle)
+        attempt = _path_waypoints(path, rho_m, middle)
         if len(attempt) <= budget:
             high, chosen = middle, attempt
         else:
@@ -141,21 +163,21 @@ def _fit_waypoints(path: FlightPath, rho_m: float, settings: MissionSettings) ->
 
 
 def _design_for_guidance(path: FlightPath, tour: Tour, frame: LocalFrame, targets: GeoTargets,
-                         settings: MissionSettings) -> GuidanceDesign:
+                         settings: MissionSettings, actions: int = 0) -> GuidanceDesign:
     """Waypoints for ArduPlane's guidance (:mod:`.guidance`) within the item budget; the
     lead-out of a landing stays a geometric polyline."""
     parameters = settings.vehicle or ARDUPLANE_DEFAULTS
     airframe = Airframe.from_parameters(parameters, settings.airspeed_m_s)
     tail = _tail_waypoints(path, tour.rho_m, settings)
-    budget = settings.max_items - _fixed_items(settings) - len(tail)
+    budget = settings.max_items - _fixed_items(settings, actions) - len(tail)
     needed = len(tour.targets_m)
     if budget < needed:
         raise MissionTooLarge(
-            f"the mission needs at least {needed + _fixed_items(settings) + len(tail)} items (one "
+            f"the mission needs at least {needed + _fixed_items(settings, actions) + len(tail)} items (one "
             f"per target) but the vehicle holds {settings.max_items} (--max-items): allow more "
             "if it has the space (ArduPilot with the mission on SD card holds about 4,300) or "
             "split the targets into several missions",
-            needed + _fixed_items(settings) + len(tail), settings.max_items)
+            needed + _fixed_items(settings, actions) + len(tail), settings.max_items)
     head = ([(Command.DO_CHANGE_SPEED, (0.0, float(settings.airspeed_m_s), -1.0, 0.0))]
             if settings.airspeed_m_s is not None else [])
     altitudes = (np.full(len(tour.targets_m), settings.altitude_m) if targets.altitudes_m is None
@@ -205,8 +227,19 @@ def build_mission(tour: Tour, frame: LocalFrame, targets: GeoTargets,
     altitudes = targets.altitudes_m
     if altitudes is not None:       # NaN: not given in the targets file, the mission's altitude
         altitudes = np.where(np.isnan(altitudes), settings.altitude_m, altitudes)
+    actions = _actions(targets, settings)
+    radius = action_items.loiter_radius_m(tour.rho_m, settings.loiter_radius_m)
+    if radius < tour.rho_m:
+        raise InputError(f"the loiter radius {radius:g} m is tighter than the turn radius "
+                         f"{tour.rho_m:g} m (--loiter-radius)")
+    loiters = {int(t): (int(actions.loiter_turns[t]), radius)
+               for t in np.flatnonzero(actions.loiter_turns)}
+    if loiters and settings.autopilot == "px4" and settings.airspeed_m_s is None:
+        raise InputError("a PX4 loiter is given in seconds (NAV_LOITER_TIME): give the airspeed "
+                         "(--airspeed) so that the turns can be timed")
     path = plan_flight_path(tour, home_m, settings.altitude_m, settings.return_mode, launch,
-                            landing, altitudes)
+                            landing, altitudes, loiters)
+    at_targets = _action_items(path, frame, targets, actions, settings)
     launch_heading = path.chain.starts[0, 2]
     if settings.launch_bearing_deg is None:
         notes.append(f"launch bearing not given: towards the first target "
@@ -217,7 +250,7 @@ def build_mission(tour: Tour, frame: LocalFrame, targets: GeoTargets,
                      "navigation, and PX4's is not modelled")
         settings = replace(settings, design="geometry")
     if settings.design == "guidance":
-        design = _design_for_guidance(path, tour, frame, targets, settings)
+        design = _design_for_guidance(path, tour, frame, targets, settings, at_targets.count)
         chosen, tolerance = design.s_m, float("nan")
         held = design.predicted_miss_m <= settings.max_miss_m
         if not held.all():
@@ -228,12 +261,17 @@ def build_mission(tour: Tour, frame: LocalFrame, targets: GeoTargets,
             notes.append(f"{int((~held).sum())} of {len(held)} targets are predicted beyond "
                          f"--max-miss {settings.max_miss_m:g} m: {listed}{more}")
     else:
-        chosen, tolerance = _fit_waypoints(path, tour.rho_m, settings)
+        chosen, tolerance = _fit_waypoints(path, tour.rho_m, settings, at_targets.count)
         if tolerance > PREFERRED_TOLERANCE_FRACTION * settings.tolerance_m:
             notes.append(f"waypoints coarsened to a tolerance of {tolerance:.3g} m to fit "
                          f"{settings.max_items} mission slots")
-    items = _items(path, chosen, frame, targets, settings, home_lat, home_lon, design)
+    items = at_targets.inserted(_items(path, chosen, frame, targets, settings, home_lat, home_lon,
+                                       design))
     summary = _summary(tour, path, items, settings, home_m)
+    if at_targets.count:
+        summary["actions"] = {role: sum(i.role == role for i in items)
+                              for role in ("photo", "roi", "gimbal", "loiter") if
+                              any(i.role == role for i in items)}
     if design is not None:
         summary.update(predicted_miss_m=design.predicted_miss_m.tolist(),
                        predicted_flight_m=design.predicted_length_m,
@@ -247,6 +285,87 @@ def build_mission(tour: Tour, frame: LocalFrame, targets: GeoTargets,
                       (np.asarray(targets.latitudes_deg), np.asarray(targets.longitudes_deg)))
     summary["vehicle_slots"] = mission.vehicle_item_count()
     return mission
+
+
+def _actions(targets: GeoTargets, settings: MissionSettings) -> TargetActions:
+    """The targets' own actions with the settings' for every target added."""
+    base = targets.actions if targets.actions is not None else TargetActions.none(len(targets))
+    return base.with_options(settings.photo, settings.roi, settings.gimbal_pitch_deg)
+
+
+@dataclass(frozen=True)
+class _AtTargets:
+    """The action items of a mission: ``before[t]`` go after the previous target's items (the
+    leg to ``t``), ``after[t]`` after ``t``'s waypoint, ``end`` after the last target's."""
+
+    before: dict[int, list[MissionItem]]
+    after: dict[int, list[MissionItem]]
+    end: list[MissionItem]
+    first: int                      # the first target visited
+    next_of: dict[int, int]         # target -> the one visited after it
+
+    @property
+    def count(self) -> int:
+        return (sum(map(len, self.before.values())) + sum(map(len, self.after.values()))
+                + len(self.end))
+
+    def inserted(self, items: list[MissionItem]) -> list[MissionItem]:
+        """``items`` (take-off, waypoints, return) with the action items in their places."""
+        if not self.count:
+            return items
+        out: list[MissionItem] = []
+        started = False
+        visited = 0
+        total = sum(item.role == "target" for item in items)
+        for item in items:
+            if not started and item.command == Command.NAV_WAYPOINT:
+                out += self.before.get(self.first, [])
+                started = True
+            out.append(item)
+            if item.role == "target":
+                visited += 1
+                out += self.after.get(item.target, [])
+                following = self.next_of.get(item.target)
+                if following is not None:
+                    out += self.before.get(following, [])
+                if visited == total:
+                    out += self.end
+        return out
+
+
+def _action_items(path: FlightPath, frame: LocalFrame, targets: GeoTargets,
+                  actions: TargetActions, settings: MissionSettings) -> _AtTargets:
+    autopilot = AUTOPILOTS[settings.autopilot]
+    order = [int(t) for t in np.argsort(path.target_s_m, kind="stable")]
+    loiters = {span.target: span for span in path.loiters}
+    before: dict[int, list[MissionItem]] = {}
+    after: dict[int, list[MissionItem]] = {}
+    pitch_now = math.nan
+    for t in order:
+        leg: list[MissionItem] = []
+        if actions.roi[t]:
+            leg.append(action_items.roi_item(autopilot, targets.latitudes_deg[t],
+                                             targets.longitudes_deg[t], t))
+        pitch = actions.gimbal_pitch_deg[t]
+        if not math.isnan(pitch) and pitch != pitch_now:
+            leg.append(action_items.gimbal_item(autopilot, float(pitch), t))
+            pitch_now = pitch
+        if leg:
+            before[t] = leg
+        at: list[MissionItem] = []
+        if actions.photo[t]:
+            at.append(action_items.photo_item(autopilot, t))
+        if t in loiters:
+            span = loiters[t]
+            latitude, longitude = frame.to_geodetic(span.centre_m.reshape(1, 2))
+            altitude = float(path.altitude_m(np.array([span.start_s_m]))[0])
+            at.append(action_items.loiter_item(autopilot, (float(latitude[0]), float(longitude[0])),
+                                               altitude, span.radius_m, span.clockwise, span.turns,
+                                               settings.airspeed_m_s, t))
+        if at:
+            after[t] = at
+    end = [action_items.roi_off_item(autopilot)] if actions.roi.any() else []
+    return _AtTargets(before, after, end, order[0] if order else -1, dict(zip(order, order[1:])))
 
 
 def _items(path: FlightPath, chosen: np.ndarray, frame: LocalFrame, targets: GeoTargets,

@@ -18,7 +18,7 @@ from ..errors import TourInvalidError
 from ..segments import SegmentChain
 from ..tour import Tour
 from ..tour.check import check_path
-from .model import FlightPath
+from .model import FlightPath, LoiterSpan
 
 #: Glide slope of the landing approach, degrees (PX4's FW_LND_ANG default is 5).
 LANDING_GLIDE_DEG = 5.0
@@ -58,9 +58,11 @@ def _unit(heading_rad: float) -> np.ndarray:
 def plan_flight_path(tour: Tour, home_m: np.ndarray, cruise_altitude_m: float,
                      return_mode: str, launch_heading_rad: float | None = None,
                      landing_heading_rad: float | None = None,
-                     target_altitudes_m: np.ndarray | None = None) -> FlightPath:
+                     target_altitudes_m: np.ndarray | None = None,
+                     loiters: dict[int, tuple[int, float]] | None = None) -> FlightPath:
     """The path from the end of the climb-out over every target (in tour order) to the end of
     the mission: the last target for ``rtl``/``none``, the approach point for ``land``.
+    ``loiters`` (target -> (turns, radius)) adds whole circles through those targets.
 
     ``launch_heading_rad`` defaults to the direction from home to the first target and
     ``landing_heading_rad`` to the launch heading (same runway, same wind).
@@ -106,8 +108,52 @@ def plan_flight_path(tour: Tour, home_m: np.ndarray, cruise_altitude_m: float,
     if return_mode == "land":
         knots_s.append(chain.length_m)
         knots_alt.append(approach(cruise_altitude_m)[0])
+    knots = (np.asarray(knots_s), np.asarray(knots_alt))
+    spans: list[LoiterSpan] = []
+    for target in sorted(loiters or {}, key=lambda t: -target_s[t]):   # the last one first
+        turns, radius = loiters[target]
+        chain, knots, span = _with_loiter(chain, knots, float(target_s[target]), target, turns,
+                                          radius, rho)
+        target_s = np.where(target_s > span.start_s_m, target_s + span.end_s_m - span.start_s_m,
+                            target_s)
+        tour_end_s += span.end_s_m - span.start_s_m
+        spans = [_shifted(other, span.end_s_m - span.start_s_m) for other in spans]
+        spans.insert(0, span)
     report = check_path(chain, rho, tour.targets_m, target_s, closed=False)
     if not report.ok:
         raise TourInvalidError("the flight path failed the checker: " + "; ".join(report.problems))
-    return FlightPath(chain, target_s, lead_in_length, tour_end_s, home,
-                      (np.asarray(knots_s), np.asarray(knots_alt)))
+    return FlightPath(chain, target_s, lead_in_length, tour_end_s, home, knots, tuple(spans))
+
+
+def _shifted(span: LoiterSpan, by_m: float) -> LoiterSpan:
+    return LoiterSpan(span.target, span.start_s_m + by_m, span.end_s_m + by_m, span.centre_m,
+                      span.radius_m, span.clockwise, span.turns)
+
+
+def _with_loiter(chain: SegmentChain, knots, s_m: float, target: int, turns: int, radius_m: float,
+                 rho_m: float):
+    """The chain with ``turns`` circles of ``radius_m`` inserted at ``s_m`` (tangent there,
+    turning the way the path turns just after, left on a straight), the altitude knots moved
+    to match, and the span."""
+    if radius_m < rho_m * (1 - 1e-9):
+        raise TourInvalidError(f"a loiter radius of {radius_m:g} m is tighter than the turn "
+                               f"radius {rho_m:g} m")
+    pose = chain.pose_at(np.array([s_m]))[0]
+    index, _ = chain.locate(np.array([min(s_m + 1e-6 * rho_m, chain.length_m)]))
+    curvature = float(chain.curvatures_1_m[int(index[0])])
+    left = curvature >= 0.0
+    sign = 1.0 if left else -1.0
+    circle = SegmentChain(pose.reshape(1, 3), np.array([2 * math.pi * radius_m * turns]),
+                          np.array([sign / radius_m]))
+    normal = np.array([-math.sin(pose[2]), math.cos(pose[2])]) * sign
+    loop = circle.length_m
+    joined = SegmentChain.concatenate([chain.between(0.0, s_m), circle,
+                                       chain.between(s_m, chain.length_m)]).without_empty(1e-12 * rho_m)
+    knots_s, knots_alt = knots
+    altitude = float(np.interp(s_m, knots_s, knots_alt))
+    after = knots_s > s_m
+    knots = (np.concatenate([knots_s[~after], [s_m + loop], knots_s[after] + loop]),
+             np.concatenate([knots_alt[~after], [altitude], knots_alt[after]]))
+    span = LoiterSpan(target, s_m, s_m + loop, pose[:2] + radius_m * normal, float(radius_m),
+                      not left, int(turns))
+    return joined, knots, span

@@ -42,13 +42,16 @@ STALL_ROUNDS = 2
 LOOKBACK_L1 = 4.0
 
 
-def _shaping_gap(s_wp: list[float], k: int, lookback_m: float) -> tuple[float, int]:
+def _shaping_gap(s_wp: list[float], k: int, lookback_m: float,
+                 loiter_ends: dict[float, float] | None = None) -> tuple[float, int]:
     """(arc length, insertion index) of a shaping waypoint for the waypoint at index ``k``:
-    the middle of the longest gap between waypoints within ``lookback_m`` of path before it."""
+    the middle of the longest gap between waypoints within ``lookback_m`` of path before it
+    (a gap after a loiter starts where its circles end: ``loiter_ends``, start -> end)."""
+    ends = loiter_ends or {}
     best_length, best = -1.0, (0.5 * s_wp[k], 0)
     j = k
     while j >= 0:
-        low = s_wp[j - 1] if j > 0 else 0.0
+        low = ends.get(s_wp[j - 1], s_wp[j - 1]) if j > 0 else 0.0
         gap = s_wp[j] - low
         if gap > best_length:
             best_length, best = gap, (0.5 * (low + s_wp[j]), j)
@@ -99,23 +102,30 @@ def _nearest_in(track_xy: np.ndarray, point: np.ndarray) -> np.ndarray:
 
 
 def _local_items(takeoff_m: np.ndarray, takeoff_alt_m: float, head_items, aim_m: np.ndarray,
-                 altitudes_m: np.ndarray, target_of: list[int],
-                 target_acceptance_m: float) -> tuple[list[LocalItem], int]:
+                 altitudes_m: np.ndarray, target_of: list[int], target_acceptance_m: float,
+                 loiters: dict[int, tuple[float, float, tuple]] | None = None
+                 ) -> tuple[list[LocalItem], list[int]]:
     """The mission the design flies (home slot, take-off, head items, the waypoints at ``aim_m``
-    relative to home, RTL), and the index of its first waypoint."""
+    relative to home, each target's loiter after it -- ``loiters``: target -> (x, y, params)
+    -- and RTL), and the seq of each waypoint."""
     items = [LocalItem(0, Command.NAV_WAYPOINT, math.nan, math.nan, 0.0, (0.0,) * 4),
              LocalItem(1, Command.NAV_TAKEOFF, float(takeoff_m[0]), float(takeoff_m[1]),
                        takeoff_alt_m, (15.0, 0.0, 0.0, 0.0))]
     for command, params in head_items:
         items.append(LocalItem(len(items), command, math.nan, math.nan, 0.0, params))
-    first = len(items)
+    seqs = []
     for point, altitude, t in zip(aim_m, altitudes_m, target_of):
+        seqs.append(len(items))
         items.append(LocalItem(len(items), Command.NAV_WAYPOINT, float(point[0]), float(point[1]),
                                float(altitude),
                                (0.0, target_acceptance_m if t >= 0 else 0.0, 0.0, 0.0)))
+        if loiters and t in loiters:
+            x, y, params = loiters[t]
+            items.append(LocalItem(len(items), Command.NAV_LOITER_TURNS, x, y, float(altitude),
+                                   params))
     items.append(LocalItem(len(items), Command.NAV_RETURN_TO_LAUNCH, math.nan, math.nan,
                            float(altitudes_m[-1]), (0.0,) * 4))
-    return items, first
+    return items, seqs
 
 
 def design_waypoints(path: FlightPath, targets_m: np.ndarray, altitudes_m: np.ndarray,
@@ -140,14 +150,19 @@ def design_waypoints(path: FlightPath, targets_m: np.ndarray, altitudes_m: np.nd
     heading = math.atan2(takeoff[1], takeoff[0])
     stalled = {int(t): 0 for t in order}
     lookback_m = LOOKBACK_L1 * airframe.l1_distance_m(airframe.airspeed_m_s)
+    loiters = {span.target: (float(span.centre_m[0] - home[0]), float(span.centre_m[1] - home[1]),
+                             (float(span.turns), 0.0,
+                              span.radius_m if span.clockwise else -span.radius_m, 1.0))
+               for span in path.loiters}
+    loiter_ends = {float(span.start_s_m): float(span.end_s_m) for span in path.loiters}
     previous_miss: np.ndarray | None = None
     for round_number in range(1, rounds + 1):
         exact = path.chain.pose_at(np.asarray(s_wp))[:, :2]
         aim = np.array([targets_m[t] + offsets[t] if t >= 0 else exact[k]
                         for k, t in enumerate(target_of)])
-        items, first = _local_items(takeoff, float(path.altitude_m(np.array([0.0]))[0]),
-                                    head_items, aim - home, path.altitude_m(np.asarray(s_wp)),
-                                    target_of, target_acceptance_m)
+        items, seqs = _local_items(takeoff, float(path.altitude_m(np.array([0.0]))[0]),
+                                   head_items, aim - home, path.altitude_m(np.asarray(s_wp)),
+                                   target_of, target_acceptance_m, loiters)
         track, reached = _fly(items, airframe, heading, len(items) - 2)
         flown = track[:, 1:] + home
         after_takeoff = track[:, 0] >= reached.get(1, 0.0)
@@ -169,7 +184,7 @@ def design_waypoints(path: FlightPath, targets_m: np.ndarray, altitudes_m: np.nd
         for k, t in enumerate(target_of):
             if t < 0 or miss[t] <= CORRECT_ABOVE * max_miss_m:
                 continue
-            seq = first + k
+            seq = seqs[k]
             begin = reached.get(seq - 1, start_s)
             end = reached.get(seq + 1, track[-1, 0])
             window = (track[:, 0] >= begin) & (track[:, 0] <= end)
@@ -179,7 +194,7 @@ def design_waypoints(path: FlightPath, targets_m: np.ndarray, altitudes_m: np.nd
             offsets[t] = offsets[t] + (targets_m[t] - nearest)
             stalled[t] = 0 if improved[t] else stalled[t] + 1
             if stalled[t] >= STALL_ROUNDS and miss[t] > max_miss_m:
-                insert.append(_shaping_gap(s_wp, k, lookback_m))
+                insert.append(_shaping_gap(s_wp, k, lookback_m, loiter_ends))
                 stalled[t] = 0
                 offsets[t] = np.zeros(2)
         for s, k in sorted(set(insert), reverse=True):

@@ -27,8 +27,10 @@ def degrees_to_e7(degrees: float) -> int:
 class MissionItem:
     """One mission item, as MISSION_ITEM_INT carries it, in plain units.
 
-    ``params`` are param1..param4; ``latitude_deg``/``longitude_deg`` are 0 for items without a
-    position (frame MISSION).  ``altitude_m`` is relative to home in frame GLOBAL_RELATIVE_ALT.
+    ``params`` are param1..param4; for items without a position (frame MISSION)
+    ``latitude_deg``/``longitude_deg`` carry param5/param6 as plain numbers (MISSION_ITEM_INT's
+    x and y unscaled, as ArduPilot and QGroundControl read them: DO_DIGICAM_CONTROL's shutter
+    flag), 0 for most.  ``altitude_m`` is relative to home in frame GLOBAL_RELATIVE_ALT.
     ``role`` says why the item is there (takeoff, speed, path, target, land_start, approach,
     land, return) and ``target`` which target (input order) a ``target`` item visits.
     """
@@ -61,11 +63,30 @@ class Home:
 class VehicleMission:
     """What a vehicle receives: the items, the home they are relative to, and the autopilot
     flavour (ArduPilot keeps home at seq 0, PX4 does not).  Files read back and planned
-    missions both give this, so uploaders and the simulator need nothing else."""
+    missions both give this, so uploaders and the simulator need nothing else.
+
+    ``autopilot_stated`` is False for a file format that does not say the autopilot (QGC WPL
+    110): ``autopilot`` is then ArduPilot's, the format's origin, and an uploader takes the
+    vehicle's instead."""
 
     items: tuple[MissionItem, ...]
     home: Home
     autopilot: Autopilot
+    autopilot_stated: bool = True
+
+
+@dataclass(frozen=True)
+class LoiterSpan:
+    """Whole circles flown through a target: ``[start_s_m, end_s_m]`` of the flight path, around
+    ``centre_m`` (local frame) at ``radius_m``."""
+
+    target: int
+    start_s_m: float
+    end_s_m: float
+    centre_m: np.ndarray
+    radius_m: float
+    clockwise: bool
+    turns: int
 
 
 @dataclass(frozen=True)
@@ -83,6 +104,15 @@ class FlightPath:
     tour_end_s_m: float
     climb_start_m: np.ndarray          # home (x, y): where the takeoff begins
     altitudes_at_s: tuple[np.ndarray, np.ndarray]   # knots (s_m, altitude_m) for np.interp
+    loiters: tuple[LoiterSpan, ...] = ()            # in path order
+
+    def in_loiter(self, s_m: np.ndarray) -> np.ndarray:
+        """Whether each arc length lies on a loiter's circles after its start."""
+        s_m = np.asarray(s_m, dtype=float)
+        inside = np.zeros(s_m.shape, dtype=bool)
+        for span in self.loiters:
+            inside |= (s_m > span.start_s_m + 1e-9) & (s_m <= span.end_s_m + 1e-9)
+        return inside
 
     def altitude_m(self, s_m: np.ndarray) -> np.ndarray:
         return np.interp(s_m, *self.altitudes_at_s)

@@ -47,6 +47,17 @@ def planned_targets(mission) -> Targets:
                    tuple(names[i] if names else f"target {i + 1}" for i in index))
 
 
+def targets_from(geodetic) -> Targets:
+    """The targets of a targets file (:class:`~dtsp_mission.targets.GeoTargets`), in its
+    order, named as ``plan`` names them; altitudes not given are not checked."""
+    count = len(geodetic)
+    altitudes = (np.full(count, np.nan) if geodetic.altitudes_m is None
+                 else np.asarray(geodetic.altitudes_m, dtype=float))
+    names = geodetic.names or tuple(f"target {i + 1}" for i in range(count))
+    return Targets(np.asarray(geodetic.latitudes_deg), np.asarray(geodetic.longitudes_deg),
+                   altitudes, tuple(names))
+
+
 def targets_in(mission: VehicleMission, names: tuple[str, ...] | None = None) -> Targets:
     """The mission's targets in visiting order: its ``target`` items (named from ``names``
     by target index), or -- for items read from a file, which carry no roles -- every
@@ -58,7 +69,9 @@ def targets_in(mission: VehicleMission, names: tuple[str, ...] | None = None) ->
         numbered = [(seq, item) for seq, item in enumerate(mission.items, start=1)
                     if item.command == Command.NAV_WAYPOINT and item.params[1] > 0]
         chosen = [item for _, item in numbered]
-        labels = tuple(f"item {seq}" for seq, _ in numbered)
+        # A file carries the targets' waypoints, not the targets: named by their visit.
+        labels = tuple(f"target waypoint {k} (item {seq})"
+                       for k, (seq, _) in enumerate(numbered, start=1))
     return Targets(np.array([i.latitude_deg for i in chosen]),
                    np.array([i.longitude_deg for i in chosen]),
                    np.array([i.altitude_m for i in chosen]), labels)

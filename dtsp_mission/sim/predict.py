@@ -18,7 +18,7 @@ from ..frame import LocalFrame
 from ..mission import VehicleMission
 from ..upload.wire import first_mission_seq, to_wire
 
-_FLOWN = (Command.NAV_WAYPOINT, Command.NAV_LOITER_TURNS)
+_FLOWN = (Command.NAV_WAYPOINT, Command.NAV_LOITER_TURNS, Command.NAV_LOITER_TIME)
 
 
 @dataclass(frozen=True)

@@ -5,7 +5,9 @@ A header row names the columns (case and surrounding spaces ignored):
 - ``lat``/``latitude`` and ``lon``/``lng``/``longitude``: degrees -> :class:`GeoTargets`;
 - ``x``/``x_m`` and ``y``/``y_m``: metres east and north of an origin -> :class:`Targets`;
 - optional ``alt``/``altitude``/``alt_m`` (metres above home; an empty cell: the mission's
-  altitude) and ``name``.
+  altitude) and ``name``;
+- optional actions at the targets (:mod:`.actions`): ``photo`` and ``roi`` (yes/no),
+  ``gimbal_pitch`` (degrees) and ``loiter_turns`` (whole circles); an empty cell: none.
 
 Fields are separated by commas, semicolons or tabs (whichever the header uses); lines starting
 with ``#`` are comments.  Other columns are kept out of the way: they are read, not used, and
@@ -24,6 +26,8 @@ import numpy as np
 from ..errors import FileFormatError
 from ..files import read_text
 from ..frame import check_geodetic
+from ..errors import InputError
+from .actions import actions_from_columns, column_key, parse_cell
 from .model import GeoTargets, Targets, check_altitudes, geodetic_targets, local_targets
 
 _COLUMNS = {
@@ -45,7 +49,13 @@ def _header(path, header: list[str], line: int) -> tuple[dict[str, int], tuple[s
                 found[key] = index
                 break
         else:
-            unused.append(raw.strip())
+            action = column_key(label)
+            if action is None:
+                unused.append(raw.strip())
+            elif action in found:
+                raise FileFormatError(f"{path}, line {line}: column {action!r} is given twice")
+            else:
+                found[action] = index
     geodetic = "lat" in found and "lon" in found
     local = "x" in found and "y" in found
     if geodetic == local:
@@ -83,6 +93,7 @@ def read_csv(path: str | os.PathLike, text: str | None = None) -> GeoTargets | T
     first, second = ("lat", "lon") if geodetic else ("x", "y")
     numbers: dict[str, list[float]] = {key: [] for key in (first, second, "alt") if key in columns}
     names: list[str] = []
+    actions: dict[str, list] = {key: [] for key in columns if column_key(key)}
     for line, row in zip(line_of[1:], rows[1:]):
         if len(row) != len(rows[0]):
             raise FileFormatError(f"{path}, line {line}: {len(row)} fields where the header has "
@@ -103,6 +114,11 @@ def read_csv(path: str | os.PathLike, text: str | None = None) -> GeoTargets | T
             values.append(value)
         if "name" in columns:
             names.append(row[columns["name"]].strip())
+        for key, cells in actions.items():
+            try:
+                cells.append(parse_cell(key, row[columns[key]], f"{path}, line {line}"))
+            except InputError as error:
+                raise FileFormatError(str(error)) from None
     if not names and not numbers[first]:
         raise FileFormatError(f"{path}: there are no targets below the header")
     altitudes = np.array(numbers["alt"]) if "alt" in numbers else None
@@ -110,9 +126,12 @@ def read_csv(path: str | os.PathLike, text: str | None = None) -> GeoTargets | T
     if altitudes is not None and np.isnan(altitudes).all():
         altitudes = None
     name_tuple = tuple(names) if "name" in columns else None
+    action_arrays = actions_from_columns(actions, len(numbers[first]))
     if geodetic:
         check_geodetic(numbers["lat"], numbers["lon"], f"{path}: target")
-        targets = geodetic_targets(numbers["lat"], numbers["lon"], name_tuple, altitudes)
+        targets = geodetic_targets(numbers["lat"], numbers["lon"], name_tuple, altitudes,
+                                   actions=action_arrays)
     else:
-        targets = local_targets(np.column_stack([numbers["x"], numbers["y"]]), name_tuple, altitudes)
+        targets = local_targets(np.column_stack([numbers["x"], numbers["y"]]), name_tuple,
+                                altitudes, action_arrays)
     return replace(targets, unused_columns=unused) if unused else targets

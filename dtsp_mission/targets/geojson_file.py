@@ -2,7 +2,8 @@
 
 Point and MultiPoint features are targets (``[longitude, latitude]``; a third coordinate is
 ignored because GeoJSON does not say what it is relative to -- use the ``alt`` property, metres
-above home).  A ``name`` property names a target.  One Polygon feature, if present, is the
+above home).  A ``name`` property names a target; ``photo``, ``roi``, ``gimbal_pitch`` and
+``loiter_turns`` properties are its actions (:mod:`.actions`).  One Polygon feature, if present, is the
 survey area.  Any other geometry is an error.
 """
 
@@ -20,6 +21,8 @@ from shapely.validation import explain_validity
 from ..errors import FileFormatError
 from ..files import read_text
 from ..frame import check_geodetic
+from ..errors import InputError
+from .actions import COLUMNS, actions_from_columns, parse_cell
 from .model import GeoTargets, check_altitudes, geodetic_targets
 
 
@@ -65,6 +68,7 @@ def read_geojson(path: str | os.PathLike, text: str | None = None) -> GeoTargets
     longitudes: list[float] = []
     names: list[str] = []
     altitudes: list[float] = []
+    action_cells: dict[str, list] = {}
     area = None
     for number, feature in enumerate(_features(data, path), start=1):
         where = f"{path}, feature {number}"
@@ -92,6 +96,15 @@ def read_geojson(path: str | os.PathLike, text: str | None = None) -> GeoTargets
             names.append(str(properties.get("name", "")))
             altitude = properties.get("alt")
             altitudes.append(np.nan if altitude is None else altitude)
+            for key, spellings in COLUMNS.items():
+                given = next((properties[p] for p in spellings if p in properties), None)
+                if given is None and key not in action_cells:
+                    continue
+                cells = action_cells.setdefault(key, [parse_cell(key, None, where)] * (len(latitudes) - 1))
+                try:
+                    cells.append(parse_cell(key, given, where))
+                except InputError as error:
+                    raise FileFormatError(str(error)) from None
     if not latitudes and area is None:
         raise FileFormatError(f"{path}: no Point features (targets) and no Polygon (area)")
     check_geodetic(latitudes, longitudes, f"{path}: target")
@@ -106,4 +119,5 @@ def read_geojson(path: str | os.PathLike, text: str | None = None) -> GeoTargets
             raise FileFormatError(f"{path}: every 'alt' property must be a number") from None
         check_altitudes(altitude_array, str(path))
     name_tuple = tuple(names) if any(names) else None
-    return geodetic_targets(latitudes, longitudes, name_tuple, altitude_array, area)
+    return geodetic_targets(latitudes, longitudes, name_tuple, altitude_array, area,
+                            actions_from_columns(action_cells, len(latitudes)))

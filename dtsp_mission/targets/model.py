@@ -9,6 +9,7 @@ import numpy as np
 from scipy.spatial import cKDTree
 
 from ..errors import InputError
+from .actions import TargetActions
 
 if TYPE_CHECKING:
     from ..frame import LocalFrame
@@ -26,6 +27,7 @@ class Targets:
     merged_duplicates: int = 0      # how many repeated positions were dropped
     altitudes_m: np.ndarray | None = None      # NaN: the mission's altitude
     unused_columns: tuple[str, ...] = ()       # columns of the file that were not used
+    actions: TargetActions | None = None       # what to do at each target (None: overfly)
 
     def __len__(self) -> int:
         return len(self.positions_m)
@@ -34,7 +36,8 @@ class Targets:
         """The same targets in degrees, through ``frame``."""
         latitudes, longitudes = frame.to_geodetic(self.positions_m)
         return GeoTargets(latitudes, longitudes, self.names, self.merged_duplicates,
-                          self.altitudes_m, unused_columns=self.unused_columns)
+                          self.altitudes_m, unused_columns=self.unused_columns,
+                          actions=self.actions)
 
 
 @dataclass(frozen=True)
@@ -52,6 +55,7 @@ class GeoTargets:
     altitudes_m: np.ndarray | None = None      # NaN: the mission's altitude
     area_deg: np.ndarray | None = None
     unused_columns: tuple[str, ...] = ()       # columns of the file that were not used
+    actions: TargetActions | None = None       # what to do at each target (None: overfly)
 
     def __post_init__(self) -> None:
         """Raise :class:`InputError` (a message for a caller of the API, naming no command-line
@@ -64,7 +68,8 @@ class GeoTargets:
                              f"{latitudes.size} latitudes and {longitudes.size} longitudes")
         from ..frame import check_geodetic
         check_geodetic(latitudes, longitudes)
-        for label, values in (("names", self.names), ("altitudes", self.altitudes_m)):
+        for label, values in (("names", self.names), ("altitudes", self.altitudes_m),
+                              ("actions", self.actions)):
             if values is not None and len(values) != len(latitudes):
                 raise InputError(f"GeoTargets has {len(latitudes)} targets but {len(values)} {label}")
         object.__setattr__(self, "latitudes_deg", latitudes)
@@ -77,17 +82,18 @@ class GeoTargets:
         """The same targets in the local frame (after checking they fit in it)."""
         frame.check_extent(self.latitudes_deg, self.longitudes_deg)
         return Targets(frame.to_local(self.latitudes_deg, self.longitudes_deg), self.names,
-                       self.merged_duplicates, self.altitudes_m, self.unused_columns)
+                       self.merged_duplicates, self.altitudes_m, self.unused_columns, self.actions)
 
     def with_area(self, area_deg: np.ndarray | None) -> "GeoTargets":
         return replace(self, area_deg=area_deg)
 
     def subset(self, indices: np.ndarray) -> "GeoTargets":
-        """The targets at ``indices`` (in that order), with their names and altitudes."""
+        """The targets at ``indices`` (in that order), with their names, altitudes and actions."""
         keep = np.asarray(indices, dtype=np.int64)
         return replace(self, latitudes_deg=self.latitudes_deg[keep],
                        longitudes_deg=self.longitudes_deg[keep], names=_pick(self.names, keep),
-                       altitudes_m=_pick(self.altitudes_m, keep), merged_duplicates=0)
+                       altitudes_m=_pick(self.altitudes_m, keep), merged_duplicates=0,
+                       actions=_pick(self.actions, keep))
 
 
 #: The highest altitude above home a target or mission may use: beyond it a number is far more
@@ -145,21 +151,25 @@ def _pick(values, keep):
         return None
     if isinstance(values, tuple):
         return tuple(values[i] for i in keep)
+    if isinstance(values, TargetActions):
+        return values.pick(keep)
     return np.asarray(values)[keep]
 
 
-def local_targets(positions_m: np.ndarray, names=None, altitudes_m=None) -> Targets:
+def local_targets(positions_m: np.ndarray, names=None, altitudes_m=None,
+                  actions: TargetActions | None = None) -> Targets:
     """:class:`Targets` with exact duplicates merged (the first one kept)."""
     keep, merged = merge_duplicates(positions_m)
     return Targets(np.asarray(positions_m, dtype=float)[keep], _pick(names, keep), merged,
-                   _pick(altitudes_m, keep))
+                   _pick(altitudes_m, keep), actions=_pick(actions, keep))
 
 
 def geodetic_targets(latitudes_deg: np.ndarray, longitudes_deg: np.ndarray, names=None,
-                     altitudes_m=None, area_deg=None) -> GeoTargets:
+                     altitudes_m=None, area_deg=None,
+                     actions: TargetActions | None = None) -> GeoTargets:
     """:class:`GeoTargets` with exact duplicates merged (the first one kept)."""
     latitudes = np.asarray(latitudes_deg, dtype=float)
     longitudes = np.asarray(longitudes_deg, dtype=float)
     keep, merged = merge_duplicates(np.column_stack([latitudes, longitudes]))
     return GeoTargets(latitudes[keep], longitudes[keep], _pick(names, keep), merged,
-                      _pick(altitudes_m, keep), area_deg)
+                      _pick(altitudes_m, keep), area_deg, actions=_pick(actions, keep))

@@ -10,7 +10,7 @@ vehicle holds when anything fails.
 from __future__ import annotations
 
 import time
-from dataclasses import dataclass
+from dataclasses import dataclass, replace
 
 from ..autopilot import MAVLINK_MAX_ITEMS, Autopilot
 from ..autopilot.parameters import ARDUPLANE_DEFAULTS, NAMES, VehicleParameters, parameters_from
@@ -124,7 +124,12 @@ def upload_mission(mission: VehicleMission, connection: str, via: str = "pymavli
     started = time.perf_counter()
     with uploader_class(connection, signing_key=signing_key, **options) as uploader:
         names = NAMES if mission.autopilot == Autopilot.ARDUPILOTMEGA else ()
-        warnings = tuple(vehicle_warnings(mission, uploader.vehicle_info(names), designed_for))
+        info = uploader.vehicle_info(names)
+        if not mission.autopilot_stated and info.autopilot in _AUTOPILOT_NAMES:
+            # A .waypoints file does not say its autopilot: it is meant for this vehicle's.
+            mission = replace(mission, autopilot=Autopilot(info.autopilot), autopilot_stated=True)
+            wire = to_wire(mission)
+        warnings = tuple(vehicle_warnings(mission, info, designed_for))
         transfer_started = time.perf_counter()
         try:
             uploader.upload(wire, progress)

@@ -39,7 +39,7 @@ def to_wire(mission: VehicleMission) -> list[WireItem]:
     wire = [home_placeholder(mission.home)] if first_mission_seq(mission.autopilot) else []
     for item in mission.items:
         x, y = ((degrees_to_e7(item.latitude_deg), degrees_to_e7(item.longitude_deg))
-                if item.has_position else (0, 0))
+                if item.has_position else (int(round(item.latitude_deg)), int(round(item.longitude_deg))))
         wire.append(WireItem.normalised(len(wire), item.frame, item.command, 0, item.autocontinue,
                                         *item.params, x, y, item.altitude_m))
     if wire:

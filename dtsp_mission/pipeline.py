@@ -1,0 +1,229 @@
+"""The planning pipeline in one place: targets -> local frame -> checked tour -> mission (or
+sorties).  The CLI's ``plan`` and the Python API (:mod:`dtsp_mission.api`) are its two faces:
+both build a :class:`PlanRequest`, call :func:`run_plan` and read the :class:`PlanResult`.
+
+Stages, each a module of its own: :mod:`.frame` (the local metric frame), :mod:`.planning`
+(the tour, with the Alternating Algorithm as the fallback when the RBTA cannot tile),
+:mod:`.mission` (the items; for the guidance design a wider turn radius where it holds more
+targets; sorties when one mission does not fit the storage or the endurance).  Writing files,
+drawing, uploading and flying read the result and are not part of it.
+"""
+
+from __future__ import annotations
+
+import time
+from dataclasses import dataclass, field
+from functools import cached_property
+from typing import Any, Callable
+
+import numpy as np
+
+from .dubins.path import check_radius
+from .errors import InputError, MissionTooLarge
+from .frame import LocalFrame, mission_centre
+from .mission import Mission, MissionSettings, build_mission
+from .mission.build import targets_beyond, with_turn_margin
+from .mission.sorties import Sortie, split_into_sorties
+from .planning import TilingUnavailable, get_planner
+from .planning.lower_bounds import LowerBound, lower_bound
+from .targets import GeoTargets, Targets
+from .tour import Tour
+
+
+@dataclass(frozen=True)
+class PlanRequest:
+    """What to plan.
+
+    ``targets`` in degrees (:class:`GeoTargets`) or local metres (:class:`Targets`, placed on
+    the earth by ``origin`` (lat, lon) if given).  ``algorithm`` and ``parameters`` choose the
+    planner; ``fallback`` plans with the Alternating Algorithm when the RBTA cannot tile.
+    ``settings`` ask for a mission (None: the tour only); ``too_large`` says what becomes of
+    a mission too large for the vehicle: ``split`` into sorties, ``note`` it (the caller wants
+    the tour) or ``raise`` :class:`~dtsp_mission.errors.MissionTooLarge`; ``endurance_s``
+    splits a longer flight into sorties.
+    """
+
+    targets: GeoTargets | Targets
+    rho_m: float
+    algorithm: str = "auto"
+    parameters: dict[str, Any] = field(default_factory=dict)
+    fallback: bool = True
+    origin: tuple[float, float] | None = None
+    settings: MissionSettings | None = None
+    too_large: str = "split"
+    endurance_s: float | None = None
+
+
+@dataclass
+class PlanResult:
+    """Everything one plan produced.
+
+    ``local`` are the targets in the frame (duplicates merged), ``geodetic`` the same in degrees
+    and ``frame`` the frame (both None for local targets without an origin).  ``mission`` is
+    the one mission (None without settings, or when it does not fit the storage);
+    ``sorties``, when not empty, are to be flown instead (``split_reason`` says why).  ``notes`` are the decisions a user should know about, in
+    the order they were taken; ``widened_from_m`` the turn radius asked for when the guidance
+    design planned with a wider one.
+    """
+
+    local: Targets
+    geodetic: GeoTargets | None
+    frame: LocalFrame | None
+    tour: Tour
+    planning_s: float
+    area_m: np.ndarray | None = None
+    mission: Mission | None = None
+    sorties: list[Sortie] = field(default_factory=list)
+    split_reason: str | None = None
+    notes: list[str] = field(default_factory=list)
+    widened_from_m: float | None = None
+
+    @cached_property
+    def bound(self) -> LowerBound:
+        """Lower bounds on the optimal tour (the 1-tree, certified; the estimate for uniform
+        targets), at the radius asked for."""
+        return _bound(self.local.positions_m, self.rho_m, self.area_m)
+
+    @property
+    def rho_m(self) -> float:
+        """The turn radius asked for (the tour's may be wider: ``widened_from_m``)."""
+        return self.widened_from_m or self.tour.rho_m
+
+    @property
+    def product(self) -> Tour | Mission:
+        """What a file writer renders: the mission if there is one, else the tour."""
+        return self.mission if self.mission is not None else self.tour
+
+
+def place(targets: GeoTargets | Targets,
+          origin: tuple[float, float] | None = None) -> tuple[Targets, GeoTargets | None, LocalFrame | None]:
+    """The targets in their local frame, in degrees, and the frame (the last two None for
+    local targets without ``origin``); :class:`InputError` if they do not fit one frame."""
+    if isinstance(targets, GeoTargets):
+        if origin is not None:
+            raise InputError("an origin is for targets in local x/y metres; these are in lat/lon")
+        frame = LocalFrame(*mission_centre(targets.latitudes_deg, targets.longitudes_deg))
+        return targets.in_frame(frame), targets, frame
+    if origin is None:
+        return targets, None, None
+    frame = LocalFrame(*origin)
+    geodetic = targets.to_geodetic(frame)
+    frame.check_extent(geodetic.latitudes_deg, geodetic.longitudes_deg)
+    return targets, geodetic, frame
+
+
+def plan_tour_in(positions_m: np.ndarray, rho_m: float, algorithm: str = "auto",
+                 parameters: dict[str, Any] | None = None, fallback: bool = True,
+                 progress: Callable[[float], None] | None = None,
+                 notes: list[str] | None = None) -> Tour:
+    """The checked tour of one planner, or of the Alternating Algorithm when the RBTA cannot
+    tile and ``fallback`` allows (said in ``notes``)."""
+    try:
+        planner = get_planner(algorithm, **(parameters or {}))
+        if progress is not None and hasattr(planner, "progress"):
+            planner.progress = progress
+        return planner.plan(positions_m, rho_m)
+    except TilingUnavailable as error:
+        if not fallback:
+            raise
+        if notes is not None:
+            notes.append(f"{error}; planning with the Alternating Algorithm instead")
+        return get_planner("alternating").plan(positions_m, rho_m)
+
+
+def _area_m(geodetic: GeoTargets | None, frame: LocalFrame | None) -> np.ndarray | None:
+    if geodetic is None or geodetic.area_deg is None:
+        return None
+    return frame.to_local(geodetic.area_deg[:, 0], geodetic.area_deg[:, 1])
+
+
+def _bound(positions: np.ndarray, rho_m: float, area_m: np.ndarray | None) -> LowerBound:
+    if area_m is not None:
+        import shapely
+        area = float(shapely.Polygon(area_m).area)
+    else:
+        area = max(float(np.ptp(positions[:, 0]) * np.ptp(positions[:, 1])), 1.0)
+    return lower_bound(positions, rho_m, area)
+
+
+def run_plan(request: PlanRequest,
+             progress: Callable[[float], None] | None = None) -> PlanResult:
+    """Plan ``request``: every stage in order, ``progress(fraction)`` while the tour improves.
+
+    Guarantees: the tour passed the geometry checker; a mission (or each sortie's) fits the
+    vehicle's storage; what was decided on the user's behalf is in ``notes``.  Bad input is an
+    :class:`~dtsp_mission.errors.InputError` before any planning.
+    """
+    check_radius(request.rho_m)
+    local, geodetic, frame = place(request.targets, request.origin)
+    if len(local) < 2:
+        raise InputError(f"{len(local)} target(s) after merging duplicates; a tour needs at "
+                         "least 2 (for one point, fly a single waypoint)")
+    if request.settings is not None and frame is None:
+        raise InputError("a mission needs targets in degrees: these are local x/y metres, so "
+                         "give their origin (lat, lon)")
+    notes: list[str] = []
+    if local.merged_duplicates:
+        notes.append(f"{local.merged_duplicates} duplicate targets merged ({len(local)} remain)")
+    area_m = _area_m(geodetic, frame)
+    if area_m is not None:
+        import shapely
+        outside = int((~shapely.contains_xy(shapely.Polygon(area_m), *local.positions_m.T)).sum())
+        if outside:
+            notes.append(f"{outside} targets lie outside the survey area")
+    started = time.perf_counter()
+    tour = plan_tour_in(local.positions_m, request.rho_m, request.algorithm, request.parameters,
+                        request.fallback, progress, notes)
+    result = PlanResult(local, geodetic, frame, tour, time.perf_counter() - started, area_m,
+                        notes=notes)
+    if request.settings is not None:
+        _design_mission(request, result)
+    return result
+
+
+def _design_mission(request: PlanRequest, result: PlanResult) -> None:
+    """The mission stage: build, widen the turns for the guidance, split where needed."""
+    settings, frame, geodetic, tour = request.settings, result.frame, result.geodetic, result.tour
+    endurance_s = request.endurance_s
+    try:
+        mission = build_mission(tour, frame, geodetic, settings)
+    except MissionTooLarge as error:
+        if request.too_large == "raise":
+            raise
+        if request.too_large == "note":     # only the tour is wanted: storage does not limit it
+            result.notes.append(f"as one mission this would not fit the vehicle: {error}")
+            return
+        _split(result, settings, f"as one mission it needs {error.needed} items (at least) but "
+                                 f"the vehicle holds {error.capacity} (--max-items)", endurance_s)
+        return
+    if "predicted_miss_m" in mission.summary:
+        replan = lambda rho: plan_tour_in(result.local.positions_m, rho, request.algorithm,  # noqa: E731
+                                          request.parameters, request.fallback)
+        widened = with_turn_margin(mission, replan, geodetic, settings)
+        if widened is not mission:
+            result.notes.append(
+                f"planned with a turn radius of {widened.rho_m:g} m instead of "
+                f"{mission.rho_m:g} m so that the autopilot's guidance can hold the turns: "
+                f"{targets_beyond(mission, settings.max_miss_m)} -> "
+                f"{targets_beyond(widened, settings.max_miss_m)} targets predicted beyond --max-miss")
+            result.widened_from_m = mission.rho_m
+            mission = widened
+            result.tour = widened.tour
+    result.mission = mission
+    flight_s = mission.summary.get("flight_time_s", 0.0)
+    if endurance_s is not None and flight_s > endurance_s:
+        _split(result, settings, f"the flight takes {flight_s / 60:.1f} min, more than the "
+                                 f"endurance of {endurance_s / 60:g} min (--endurance)", endurance_s)
+
+
+def _split(result: PlanResult, settings: MissionSettings, reason: str,
+           endurance_s: float | None) -> None:
+    frame = result.frame
+    home_m = (frame.to_local(*settings.home_deg)[0] if settings.home_deg is not None
+              else np.zeros(2))
+    result.sorties = split_into_sorties(result.tour, frame, result.geodetic, settings, home_m,
+                                        endurance_s)
+    result.split_reason = reason
+
+
+__all__ = ["PlanRequest", "PlanResult", "place", "plan_tour_in", "run_plan"]
