@@ -6,7 +6,9 @@ about seven items per target and still miss targets by 10-40 m.  Here the items 
 predicting the flight with the autopilot model (:mod:`dtsp_mission.autopilot.navigation`,
 checked against recorded ArduPlane flights) and repairing what it misses:
 
-1. every target is one NAV_WAYPOINT, nothing else;
+1. every target is one NAV_WAYPOINT; a loop of the exact path (an arc turning more than half
+   a circle: a sharp change of direction between close targets) gets a waypoint every quarter
+   turn on it, because from its ends alone the autopilot cuts inside it the wrong way round;
 2. fly the mission in the model; a target the predicted track misses by more than
    ``max_miss_m`` has its waypoint moved by the miss (the aim point: where the autopilot must
    be sent so that it passes over the target);
@@ -128,6 +130,33 @@ def _local_items(takeoff_m: np.ndarray, takeoff_alt_m: float, head_items, aim_m:
     return items, seqs
 
 
+#: An arc of the exact path turning more than this is a loop the guidance does not fly from
+#: its ends alone (it cuts inside, the wrong way round): it gets waypoints on it from the start.
+LOOP_MIN_RAD = math.pi
+#: Spacing of those waypoints along the loop, as turn angle.
+LOOP_STEP_RAD = math.pi / 2
+
+
+def _loop_waypoints(path: FlightPath, room: int) -> np.ndarray:
+    """Arc lengths of waypoints on the loops of the tour part of ``path`` (arcs turning more
+    than :data:`LOOP_MIN_RAD`), every :data:`LOOP_STEP_RAD` of turn, at most ``room``."""
+    chain = path.chain
+    offsets = chain.offsets_m
+    turn = np.abs(chain.curvatures_1_m) * chain.lengths_m
+    chosen = []
+    for k in np.flatnonzero(turn > LOOP_MIN_RAD):
+        start = offsets[k]
+        if start < path.tour_start_s_m - 1e-9 or start > path.tour_end_s_m:
+            continue
+        count = int(math.ceil(turn[k] / LOOP_STEP_RAD)) - 1
+        step = chain.lengths_m[k] / (count + 1)
+        chosen += [start + step * (j + 1) for j in range(count)]
+    chosen = np.asarray(chosen, dtype=float)
+    if path.loiters:
+        chosen = chosen[~path.in_loiter(chosen)]
+    return chosen[:max(room, 0)]
+
+
 def design_waypoints(path: FlightPath, targets_m: np.ndarray, altitudes_m: np.ndarray,
                      airframe: Airframe, max_miss_m: float, budget: int,
                      head_items: list[tuple[int, tuple[float, float, float, float]]] = (),
@@ -144,6 +173,10 @@ def design_waypoints(path: FlightPath, targets_m: np.ndarray, altitudes_m: np.nd
     order = np.argsort(path.target_s_m, kind="stable")
     s_wp = list(path.target_s_m[order])
     target_of = list(order)
+    for s in _loop_waypoints(path, budget - len(s_wp)):
+        k = int(np.searchsorted(s_wp, s))
+        s_wp.insert(k, float(s))
+        target_of.insert(k, -1)
     offsets = {int(t): np.zeros(2) for t in order}        # aim minus target, per target
     best: tuple[float, GuidanceDesign] | None = None
     takeoff = path.chain.pose_at(np.array([0.0]))[0, :2] - home

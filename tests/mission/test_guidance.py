@@ -72,3 +72,43 @@ def test_the_same_input_gives_the_same_mission(designed):
     again = build_mission(tour, frame, targets, MissionSettings(altitude_m=120.0, airspeed_m_s=22.0,
                                                                  design="guidance"))
     assert again.items == mission.items
+
+
+def _fence(rho_m: float):
+    """A rectangular fence of 32 posts 40 m apart, visited along its sides: each corner is a
+    loop of the exact path (a 90-degree turn between posts 40 m apart)."""
+    import math
+
+    from dtsp_mission.tour import tour_through_poses
+    points, headings = [], []
+    for (x, y), (dx, dy) in (((0, 0), (1, 0)), ((320, 0), (0, 1)), ((320, 320), (-1, 0)),
+                             ((0, 320), (0, -1))):
+        for j in range(8):
+            points.append((x + dx * 40.0 * j, y + dy * 40.0 * j))
+            headings.append(math.atan2(dy, dx))
+    points = np.array(points)
+    frame = LocalFrame(46.8, 6.95)
+    tour = tour_through_poses(points, np.arange(len(points)), np.array(headings), rho_m)
+    return tour, frame, local_targets(points).to_geodetic(frame)
+
+
+def test_loops_of_the_exact_path_get_waypoints_and_are_flown_round(monkeypatch):
+    """ArduPlane given only a loop's ends cuts inside it, the wrong way round, and misses the
+    posts after it (the bundled site's fence corners); waypoints on the loop make it fly the
+    loop: fewer targets beyond the limit, a smaller worst miss, a predicted flight closer to
+    the planned one."""
+    import dtsp_mission.mission.guidance as guidance
+    tour, frame, targets = _fence(104.0)
+    settings = MissionSettings(design="guidance", airspeed_m_s=22.0, altitude_m=120.0)
+    looped = build_mission(tour, frame, targets, settings)
+    monkeypatch.setattr(guidance, "LOOP_MIN_RAD", float("inf"))
+    bare = build_mission(tour, frame, targets, settings)
+
+    def figures(mission):
+        miss = np.array(mission.summary["predicted_miss_m"])
+        ratio = mission.summary["predicted_flight_m"] / mission.summary["planned_flight_m"]
+        return int((miss > 5.0).sum()), float(miss.max()), abs(ratio - 1.0)
+    beyond, worst, off = figures(looped)
+    beyond_bare, worst_bare, off_bare = figures(bare)
+    assert beyond < beyond_bare and worst < worst_bare and off < off_bare
+    assert looped.summary["items"] <= bare.summary["items"]
