@@ -66,18 +66,21 @@ def _evaluate(mission, targets, airframe) -> dict:
 LIMITS = """
 ## What limits it
 
-- Lines of targets closer together than ArduPlane's L1 distance (NAVL1_PERIOD 15 s: about 79 m
-  at 22 m/s), entered from a turn: the guidance needs a few hundred metres of line to settle,
-  so the first posts of the bundled site's fence (40 m apart) and tank rims are passed 10-55 m
-  off; aiming and shaping waypoints on the exact path cannot straighten an entry the tour does
-  not have. The bundled site: 41 of 272 targets beyond 5 m at 1.01 items per target (105 with
-  the tours before the improvement stage), the predicted flight 21 % shorter than the exact path
-  (the aircraft cuts the loops it cannot fly).
-- Clustered sites (Gaussian clusters, sigma 150 m): 10 of 100 and 31 of 400 targets beyond 5 m,
-  at 1.51 and 1.64 items per target; the 400-target site is held back by the 655-item budget
-  (the shaping waypoints that would hold the rest do not fit). A mission that does not fit at
-  all is split into sorties (`plan` writes `mission-1.plan`, ...; `docs/missions.md`); a
-  design that fits but is budget-bound is not split.
+- Loops of the exact path (an arc turning more than half a circle: a sharp change of direction
+  between close targets -- the fence corners and pylon-line ends of the bundled site) get a
+  waypoint every quarter turn from the start; without them ArduPlane cut inside every loop the
+  wrong way round and missed the targets after it by 10-55 m (bundled site: 41 targets beyond
+  5 m at 1.01 items per target, the predicted flight 21 % shorter than the exact path; now 16
+  at 1.22, 3.6 % shorter).
+- What is left on the bundled site: the ends of the pylon lines, where a loop closes back onto
+  the line within ArduPlane's L1 distance (about 79 m at 22 m/s): the guidance is still
+  settling when it reaches the next pylons (worst 13.8 m).
+- Clustered sites (Gaussian clusters, sigma 150 m): 2 of 100 and 18 of 400 targets beyond 5 m,
+  at 1.61 and 1.64 items per target; the 400-target site is held back by the 655-item budget
+  (the shaping waypoints that would hold the rest do not fit; its worst target, 44.5 m, is in
+  a cluster the budget left unshaped). A mission that does not fit at all is split into
+  sorties (`plan` writes `mission-1.plan`, ...; `docs/missions.md`); a design that fits but is
+  budget-bound is not split.
 - The design trusts the flight model: its agreement with real ArduPlane flights is measured in
   `arduplane-agreement.md` (closest approach within about 1 m of ArduPlane's on the recorded
   dtsp-mission missions); nothing here was flown by a real ArduPlane.
