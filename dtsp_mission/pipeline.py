@@ -193,8 +193,8 @@ def _design_mission(request: PlanRequest, result: PlanResult) -> None:
         if request.too_large == "note":     # only the tour is wanted: storage does not limit it
             result.notes.append(f"as one mission this would not fit the vehicle: {error}")
             return
-        _split(result, settings, f"as one mission it needs {error.needed} items (at least) but "
-                                 f"the vehicle holds {error.capacity} (--max-items)", endurance_s)
+        _split(request, result, f"as one mission it needs {error.needed} items (at least) but "
+                                f"the vehicle holds {error.capacity} (--max-items)")
         return
     if "predicted_miss_m" in mission.summary:
         replan = lambda rho: plan_tour_in(result.local.positions_m, rho, request.algorithm,  # noqa: E731
@@ -212,17 +212,20 @@ def _design_mission(request: PlanRequest, result: PlanResult) -> None:
     result.mission = mission
     flight_s = mission.summary.get("flight_time_s", 0.0)
     if endurance_s is not None and flight_s > endurance_s:
-        _split(result, settings, f"the flight takes {flight_s / 60:.1f} min, more than the "
-                                 f"endurance of {endurance_s / 60:g} min (--endurance)", endurance_s)
+        _split(request, result, f"the flight takes {flight_s / 60:.1f} min, more than the "
+                                f"endurance of {endurance_s / 60:g} min (--endurance)")
 
 
-def _split(result: PlanResult, settings: MissionSettings, reason: str,
-           endurance_s: float | None) -> None:
-    frame = result.frame
+def _split(request: PlanRequest, result: PlanResult, reason: str) -> None:
+    """Sorties of the tour, each planned again with wider turns where the guidance needs
+    them (as a single mission is)."""
+    settings, frame = request.settings, result.frame
     home_m = (frame.to_local(*settings.home_deg)[0] if settings.home_deg is not None
               else np.zeros(2))
+    replan = lambda positions, rho: plan_tour_in(positions, rho, request.algorithm,  # noqa: E731
+                                                 request.parameters, request.fallback)
     result.sorties = split_into_sorties(result.tour, frame, result.geodetic, settings, home_m,
-                                        endurance_s)
+                                        request.endurance_s, replan)
     result.split_reason = reason
 
 

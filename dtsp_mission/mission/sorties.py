@@ -10,6 +10,7 @@ the number of sorties is the smallest whose missions all fit ``max_items``.
 from __future__ import annotations
 
 from dataclasses import dataclass
+from typing import Callable
 
 import numpy as np
 
@@ -17,7 +18,7 @@ from ..errors import InputError, MissionTooLarge
 from ..frame import LocalFrame
 from ..targets import GeoTargets
 from ..tour import Tour, tour_through_poses
-from .build import MissionSettings, build_mission
+from .build import MissionSettings, build_mission, targets_beyond, with_turn_margin
 from .model import Mission
 
 #: Most sorties tried before giving up.
@@ -72,11 +73,17 @@ def _cuts(arc_m: np.ndarray, to_home_m: np.ndarray, count: int, first: int) -> t
 
 def split_into_sorties(tour: Tour, frame: LocalFrame, targets: GeoTargets,
                        settings: MissionSettings, home_m: np.ndarray,
-                       endurance_s: float | None = None) -> list[Sortie]:
+                       endurance_s: float | None = None,
+                       replan: Callable[[np.ndarray, float], Tour] | None = None) -> list[Sortie]:
     """The fewest sorties (at least 2) whose missions each fit ``settings.max_items`` and,
     with ``endurance_s``, each fly within it (from take-off to the return, at the mission's
     airspeed), balanced by estimated flight time; :class:`InputError` if none up to
-    :data:`MAX_SORTIES` does."""
+    :data:`MAX_SORTIES` does.
+
+    With ``replan(positions_m, rho_m)`` (a planner), a guidance-designed sortie whose targets
+    are predicted beyond ``settings.max_miss_m`` is planned again with the wider turn radii of
+    :func:`~.build.with_turn_margin`, as a single mission is, where that holds more of its
+    targets and still fits the storage and the endurance."""
     n = len(tour.targets_m)
     order = tour.visit_order
     poses = tour.visit_poses()[order]
@@ -101,6 +108,10 @@ def split_into_sorties(tour: Tour, frame: LocalFrame, targets: GeoTargets,
                                           poses[piece, 2], tour.rho_m, tour.planner, tour.parameters)
                 mission = build_mission(part, frame, targets.subset(chosen), settings)
                 flight_s = mission.summary.get("flight_time_s", 0.0)
+                fits = endurance_s is None or flight_s <= endurance_s
+                if replan is not None and fits and targets_beyond(mission, settings.max_miss_m):
+                    mission = _widened(mission, chosen, tour, targets, settings, endurance_s, replan)
+                    flight_s = mission.summary.get("flight_time_s", 0.0)
                 if endurance_s is not None and flight_s > endurance_s:
                     raise _TooLong(f"a sortie would fly {flight_s / 60:.1f} min, more than the "
                                    f"endurance of {endurance_s / 60:g} min")
@@ -111,6 +122,17 @@ def split_into_sorties(tour: Tour, frame: LocalFrame, targets: GeoTargets,
     raise InputError(f"even {min(MAX_SORTIES, n)} sorties do not fit the vehicle "
                      f"({settings.max_items} items"
                      f"{f', {endurance_s / 60:g} min of endurance' if endurance_s else ''}): {last_error}")
+
+
+def _widened(mission, chosen, tour, targets, settings, endurance_s, replan):
+    """The sortie's mission planned with a wider turn radius if that holds more targets and
+    still flies within the endurance; else ``mission``."""
+    positions = tour.targets_m[chosen]
+    candidate = with_turn_margin(mission, lambda rho: replan(positions, rho),
+                                 targets.subset(chosen), settings)
+    if endurance_s is not None and candidate.summary.get("flight_time_s", 0.0) > endurance_s:
+        return mission
+    return candidate
 
 
 class _TooLong(Exception):

@@ -1,0 +1,77 @@
+"""The pipeline (``dtsp_mission.pipeline.run_plan``): what it decides on the user's behalf is
+in its notes, in order, and sorties get the same care as a single mission."""
+
+from __future__ import annotations
+
+import numpy as np
+import pytest
+
+from dtsp_mission.errors import InputError, MissionTooLarge
+from dtsp_mission.mission import MissionSettings
+from dtsp_mission.mission.build import targets_beyond
+from dtsp_mission.pipeline import PlanRequest, run_plan
+from dtsp_mission.targets.model import local_targets
+
+
+def _site(count: int = 60, seed: int = 11):
+    positions = np.random.default_rng(seed).uniform(-1500.0, 1500.0, (count, 2))
+    return local_targets(positions)
+
+
+def test_local_targets_plan_a_tour_and_need_an_origin_for_a_mission():
+    targets = _site()
+    tour_only = run_plan(PlanRequest(targets, 80.0, "alternating"))
+    assert tour_only.mission is None and tour_only.frame is None
+    assert tour_only.tour.length_m >= tour_only.bound.one_tree_m
+    with pytest.raises(InputError, match="origin"):
+        run_plan(PlanRequest(targets, 80.0, "alternating", settings=MissionSettings()))
+    placed = run_plan(PlanRequest(targets, 80.0, "alternating", origin=(46.8, 6.95),
+                                  settings=MissionSettings()))
+    assert placed.mission is not None and placed.product is placed.mission
+
+
+def test_a_mission_too_large_is_split_noted_or_raised_as_asked():
+    targets = _site(40)
+    settings = MissionSettings(design="geometry", max_items=120)
+    common = dict(algorithm="alternating", origin=(46.8, 6.95), settings=settings)
+    split = run_plan(PlanRequest(targets, 80.0, **common))
+    assert len(split.sorties) >= 2 and split.mission is None and "holds 120" in split.split_reason
+    assert sorted(np.concatenate([s.targets for s in split.sorties]).tolist()) == list(range(40))
+    noted = run_plan(PlanRequest(targets, 80.0, too_large="note", **common))
+    assert not noted.sorties and any("would not fit" in n for n in noted.notes)
+    with pytest.raises(MissionTooLarge):
+        run_plan(PlanRequest(targets, 80.0, too_large="raise", **common))
+
+
+def test_sorties_are_planned_with_wider_turns_where_the_guidance_needs_them():
+    """A sortie of a guidance design gets the wider turn radius a single mission gets where
+    that holds more of its targets (sorties used to keep the radius asked for)."""
+    import math
+
+    from dtsp_mission.frame import LocalFrame
+    from dtsp_mission.mission.sorties import split_into_sorties
+    from dtsp_mission.pipeline import plan_tour_in
+    from dtsp_mission.tour import tour_through_poses
+    points, headings = [], []       # a fence of 32 posts 40 m apart, visited along its sides
+    for (x, y), (dx, dy) in (((0, 0), (1, 0)), ((320, 0), (0, 1)), ((320, 320), (-1, 0)),
+                             ((0, 320), (0, -1))):
+        for j in range(8):
+            points.append((x + dx * 40.0 * j, y + dy * 40.0 * j))
+            headings.append(math.atan2(dy, dx))
+    points = np.array(points)
+    frame = LocalFrame(46.8, 6.95)
+    targets = local_targets(points).to_geodetic(frame)
+    tour = tour_through_poses(points, np.arange(len(points)), np.array(headings), 80.0)
+    settings = MissionSettings(design="guidance", airspeed_m_s=22.0, max_items=40)
+    home = np.array([160.0, 160.0])
+    kept = split_into_sorties(tour, frame, targets, settings, home)
+    widened = split_into_sorties(tour, frame, targets, settings, home, None,
+                                 lambda xy, rho: plan_tour_in(xy, rho, "alternating"))
+    assert len(kept) == len(widened) >= 2
+    assert {s.mission.rho_m for s in kept} == {80.0}
+    assert max(s.mission.rho_m for s in widened) > 80.0
+    beyond = [targets_beyond(s.mission, 5.0) for s in widened]
+    assert sum(beyond) < sum(targets_beyond(s.mission, 5.0) for s in kept)
+    for sortie in widened:
+        assert sortie.mission.vehicle_item_count() <= 40
+        assert sum(i.role == "target" for i in sortie.mission.items) == len(sortie.targets)
