@@ -62,8 +62,8 @@ class PlanResult:
     and ``frame`` the frame (both None for local targets without an origin).  ``mission`` is
     the one mission (None without settings, or when it does not fit the storage);
     ``sorties``, when not empty, are to be flown instead (``split_reason`` says why).  ``notes`` are the decisions a user should know about, in
-    the order they were taken; ``widened_from_m`` the turn radius asked for when the guidance
-    design planned with a wider one.
+    the order they were taken.  ``tour`` is the tour at the radius asked for; the guidance
+    design may have planned the mission with a wider one (``mission.tour``, ``mission.rho_m``).
     """
 
     local: Targets
@@ -76,18 +76,12 @@ class PlanResult:
     sorties: list[Sortie] = field(default_factory=list)
     split_reason: str | None = None
     notes: list[str] = field(default_factory=list)
-    widened_from_m: float | None = None
 
     @cached_property
     def bound(self) -> LowerBound:
         """Lower bounds on the optimal tour (the 1-tree, certified; the estimate for uniform
         targets), at the radius asked for."""
-        return _bound(self.local.positions_m, self.rho_m, self.area_m)
-
-    @property
-    def rho_m(self) -> float:
-        """The turn radius asked for (the tour's may be wider: ``widened_from_m``)."""
-        return self.widened_from_m or self.tour.rho_m
+        return _bound(self.local.positions_m, self.tour.rho_m, self.area_m)
 
     @property
     def product(self) -> Tour | Mission:
@@ -206,9 +200,7 @@ def _design_mission(request: PlanRequest, result: PlanResult) -> None:
                 f"{mission.rho_m:g} m so that the autopilot's guidance can hold the turns: "
                 f"{targets_beyond(mission, settings.max_miss_m)} -> "
                 f"{targets_beyond(widened, settings.max_miss_m)} targets predicted beyond --max-miss")
-            result.widened_from_m = mission.rho_m
             mission = widened
-            result.tour = widened.tour
     result.mission = mission
     flight_s = mission.summary.get("flight_time_s", 0.0)
     if endurance_s is not None and flight_s > endurance_s:

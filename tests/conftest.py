@@ -100,3 +100,19 @@ def start_vehicle():
     yield start
     for vehicle in started:
         vehicle.stop()
+
+
+def fence_poses(posts_per_side: int = 8, gap_m: float = 40.0):
+    """Posts of a square fence ``gap_m`` apart, visited along its sides: (points (n, 2),
+    headings (n,)) in a local frame.  Each corner is a sharp turn between close posts -- a
+    loop of the exact Dubins path, as at the bundled site's fence."""
+    import math
+    side = posts_per_side * gap_m
+    points, headings = [], []
+    for (x, y), (dx, dy) in (((0, 0), (1, 0)), ((side, 0), (0, 1)), ((side, side), (-1, 0)),
+                             ((0, side), (0, -1))):
+        for j in range(posts_per_side):
+            points.append((x + dx * gap_m * j, y + dy * gap_m * j))
+            headings.append(math.atan2(dy, dx))
+    return np.array(points), np.array(headings)
+

@@ -46,22 +46,15 @@ def test_a_mission_too_large_is_split_noted_or_raised_as_asked():
 def test_sorties_are_planned_with_wider_turns_where_the_guidance_needs_them():
     """A sortie of a guidance design gets the wider turn radius a single mission gets where
     that holds more of its targets (sorties used to keep the radius asked for)."""
-    import math
-
+    from conftest import fence_poses
     from dtsp_mission.frame import LocalFrame
     from dtsp_mission.mission.sorties import split_into_sorties
     from dtsp_mission.pipeline import plan_tour_in
     from dtsp_mission.tour import tour_through_poses
-    points, headings = [], []       # a fence of 32 posts 40 m apart, visited along its sides
-    for (x, y), (dx, dy) in (((0, 0), (1, 0)), ((320, 0), (0, 1)), ((320, 320), (-1, 0)),
-                             ((0, 320), (0, -1))):
-        for j in range(8):
-            points.append((x + dx * 40.0 * j, y + dy * 40.0 * j))
-            headings.append(math.atan2(dy, dx))
-    points = np.array(points)
+    points, headings = fence_poses()
     frame = LocalFrame(46.8, 6.95)
     targets = local_targets(points).to_geodetic(frame)
-    tour = tour_through_poses(points, np.arange(len(points)), np.array(headings), 80.0)
+    tour = tour_through_poses(points, np.arange(len(points)), headings, 80.0)
     settings = MissionSettings(design="guidance", airspeed_m_s=22.0, max_items=40)
     home = np.array([160.0, 160.0])
     kept = split_into_sorties(tour, frame, targets, settings, home)

@@ -75,20 +75,11 @@ def test_the_same_input_gives_the_same_mission(designed):
 
 
 def _fence(rho_m: float):
-    """A rectangular fence of 32 posts 40 m apart, visited along its sides: each corner is a
-    loop of the exact path (a 90-degree turn between posts 40 m apart)."""
-    import math
-
+    from conftest import fence_poses
     from dtsp_mission.tour import tour_through_poses
-    points, headings = [], []
-    for (x, y), (dx, dy) in (((0, 0), (1, 0)), ((320, 0), (0, 1)), ((320, 320), (-1, 0)),
-                             ((0, 320), (0, -1))):
-        for j in range(8):
-            points.append((x + dx * 40.0 * j, y + dy * 40.0 * j))
-            headings.append(math.atan2(dy, dx))
-    points = np.array(points)
+    points, headings = fence_poses()
     frame = LocalFrame(46.8, 6.95)
-    tour = tour_through_poses(points, np.arange(len(points)), np.array(headings), rho_m)
+    tour = tour_through_poses(points, np.arange(len(points)), headings, rho_m)
     return tour, frame, local_targets(points).to_geodetic(frame)
 
 
