@@ -150,7 +150,7 @@ def test_a_site_too_big_for_the_vehicle_is_flown_as_sorties_it_accepts(tmp_path,
     capacity = 120
     out = tmp_path / "site.plan"
     result = run("plan", SITE, "--radius", 80, "--alt", 120, "--airspeed", 22, "--home",
-                 "46.8155,6.9618", "--max-items", capacity, "-o", out, "--time-limit", 2)
+                 "46.8155,6.9618", "--max-items", capacity, "-o", out, "--time-limit", 0)
     assert result.exit_code == 0, result.output
     count = int(re.search(r"split into (\d+) sorties", result.output).group(1))
     files = [tmp_path / f"site-{k}.plan" for k in range(1, count + 1)]

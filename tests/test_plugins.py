@@ -43,6 +43,7 @@ def test_plugins_command_lists_builtins_and_first_party_plugins():
 def site_files(tmp_path_factory):
     out = tmp_path_factory.mktemp("site")
     result = run("plan", SITE, "--radius", "80", "--alt", "120", "--airspeed", "22", "--time-limit", "1",
+                 "--design", "geometry",
                  "--max-items", "4000", "-o", str(out / "site.kml"), "-o", str(out / "site.fence.plan"),
                  "-o", str(out / "site.plan"))
     assert result.returncode == 0, result.stderr
@@ -112,7 +113,8 @@ def test_a_broken_exporter_plugin_is_listed_and_skipped(tmp_path):
     assert "shapefile" in listing.stdout and "broken-exporter 1.0" in listing.stdout
     assert "BROKEN: ModuleNotFoundError" in listing.stdout
     assert "BROKEN: TypeError" in listing.stdout and "2 broken plugin(s)" in listing.stderr
-    planned = run("plan", SITE, "--radius", "80", "--max-items", "4000", "--time-limit", "1", "-o",
+    planned = run("plan", SITE, "--radius", "80", "--max-items", "4000", "--time-limit", "1",
+                  "--design", "geometry", "-o",
                   str(tmp_path / "m.plan"), env=env)
     assert planned.returncode == 0, planned.stderr
     assert (tmp_path / "m.plan").exists()
