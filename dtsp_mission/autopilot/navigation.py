@@ -125,7 +125,7 @@ class AircraftState:
 
 
 #: Commands without a position, whatever frame a vehicle stores them in.
-_NO_POSITION = {Command.NAV_RETURN_TO_LAUNCH, Command.DO_CHANGE_SPEED}
+_NO_POSITION = {Command.NAV_RETURN_TO_LAUNCH}
 
 
 def local_items(wire: list, frame, home_amsl_m: float) -> list[LocalItem]:

@@ -68,18 +68,24 @@ def gimbal_item(autopilot: Autopilot, pitch_deg: float, target: int) -> MissionI
                target=target)
 
 
+def loiter_turns_params(turns: int, radius_m: float, clockwise: bool) -> tuple[float, ...]:
+    """NAV_LOITER_TURNS' param1-4: the turns, the radius signed by direction (positive
+    clockwise), the tangent exit."""
+    return (float(turns), 0.0, float(radius_m if clockwise else -radius_m), 1.0)
+
+
 def loiter_item(autopilot: Autopilot, centre_deg: tuple[float, float], altitude_m: float,
                 radius_m: float, clockwise: bool, turns: int, airspeed_m_s: float | None,
                 target: int) -> MissionItem:
     """``turns`` circles of ``radius_m`` around ``centre_deg``, leaving along the tangent.  PX4
     takes no turn count: the time they take at ``airspeed_m_s``."""
-    signed = radius_m if clockwise else -radius_m
+    params = loiter_turns_params(turns, radius_m, clockwise)
     if autopilot == Autopilot.ARDUPILOTMEGA:
-        command, first = Command.NAV_LOITER_TURNS, float(turns)
-    else:
+        command = Command.NAV_LOITER_TURNS
+    else:        # the same with the turns as the seconds they take
         command = Command.NAV_LOITER_TIME
-        first = float(math.ceil(turns * 2 * math.pi * radius_m / airspeed_m_s))
-    return MissionItem(int(command), Frame.GLOBAL_RELATIVE_ALT, (first, 0.0, float(signed), 1.0),
+        params = (float(math.ceil(turns * 2 * math.pi * radius_m / airspeed_m_s)), *params[1:])
+    return MissionItem(int(command), Frame.GLOBAL_RELATIVE_ALT, params,
                        float(centre_deg[0]), float(centre_deg[1]), float(altitude_m), True,
                        "loiter", target)
 

@@ -10,6 +10,7 @@ the approach waypoint and NAV_LAND at home, or nothing.
 from __future__ import annotations
 
 import math
+from collections import Counter
 from dataclasses import dataclass, replace
 from typing import Callable
 
@@ -228,10 +229,7 @@ def build_mission(tour: Tour, frame: LocalFrame, targets: GeoTargets,
     if altitudes is not None:       # NaN: not given in the targets file, the mission's altitude
         altitudes = np.where(np.isnan(altitudes), settings.altitude_m, altitudes)
     actions = _actions(targets, settings)
-    radius = action_items.loiter_radius_m(tour.rho_m, settings.loiter_radius_m)
-    if radius < tour.rho_m:
-        raise InputError(f"the loiter radius {radius:g} m is tighter than the turn radius "
-                         f"{tour.rho_m:g} m (--loiter-radius)")
+    radius = action_items.loiter_radius_m(tour.rho_m, settings.loiter_radius_m)  # >= rho: checked
     loiters = {int(t): (int(actions.loiter_turns[t]), radius)
                for t in np.flatnonzero(actions.loiter_turns)}
     if loiters and settings.autopilot == "px4" and settings.airspeed_m_s is None:
@@ -269,9 +267,9 @@ def build_mission(tour: Tour, frame: LocalFrame, targets: GeoTargets,
                                        design))
     summary = _summary(tour, path, items, settings, home_m)
     if at_targets.count:
-        summary["actions"] = {role: sum(i.role == role for i in items)
-                              for role in ("photo", "roi", "gimbal", "loiter") if
-                              any(i.role == role for i in items)}
+        counts = Counter(item.role for item in items)
+        summary["actions"] = {role: counts[role] for role in ("photo", "roi", "gimbal", "loiter")
+                              if counts[role]}
     if design is not None:
         summary.update(predicted_miss_m=design.predicted_miss_m.tolist(),
                        predicted_flight_m=design.predicted_length_m,

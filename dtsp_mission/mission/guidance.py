@@ -29,6 +29,7 @@ import numpy as np
 
 from ..autopilot.commands import Command
 from ..autopilot.navigation import Airframe, LocalItem, MissionFlight, closest_approach_m
+from .actions import loiter_turns_params
 from .model import FlightPath
 
 #: Prediction time step, s (the agreement with ArduPlane was measured at 0.02 s; 0.05 s
@@ -184,8 +185,7 @@ def design_waypoints(path: FlightPath, targets_m: np.ndarray, altitudes_m: np.nd
     stalled = {int(t): 0 for t in order}
     lookback_m = LOOKBACK_L1 * airframe.l1_distance_m(airframe.airspeed_m_s)
     loiters = {span.target: (float(span.centre_m[0] - home[0]), float(span.centre_m[1] - home[1]),
-                             (float(span.turns), 0.0,
-                              span.radius_m if span.clockwise else -span.radius_m, 1.0))
+                             loiter_turns_params(span.turns, span.radius_m, span.clockwise))
                for span in path.loiters}
     loiter_ends = {float(span.start_s_m): float(span.end_s_m) for span in path.loiters}
     previous_miss: np.ndarray | None = None
