@@ -103,7 +103,7 @@ def _duration(seconds: float) -> str:
               help="Work budget of auto's improvement stage, in seconds of the reference machine "
                    "(a fixed amount of work: the same input, limit and --seed give the same tour "
                    "everywhere). Default 7 s up to 2,000 targets, 2.8 ms more per target "
-                   "above, at most 60 s; 0 keeps the best peer's tour.")
+                   "above, at most 30 s; 0 keeps the best peer's tour.")
 @click.option("--fallback/--no-fallback", default=True, show_default=True,
               help="If the RBTA cannot tile (too few targets), plan with the Alternating "
                    "Algorithm instead of failing.")

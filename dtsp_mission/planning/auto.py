@@ -1,8 +1,8 @@
 """``auto``: every applicable built-in planner, the shortest checked tour, then improved.
 
 The peers are the RBTA (when the targets are numerous enough to tile), the Alternating
-Algorithm, the heading-optimised Euclidean tour, the lanes and the Dubins nearest neighbour
-(up to :data:`NEAREST_MAX_TARGETS` targets); the shortest of their tours goes through the Dubins-aware improvement stage
+Algorithm, the lanes, and up to :data:`SLOW_PEERS_MAX_TARGETS` targets the heading-optimised
+Euclidean tour and the Dubins nearest neighbour; the shortest of their tours goes through the Dubins-aware improvement stage
 (:mod:`~dtsp_mission.planning.improve`), so the result is never longer than any peer it ran.
 """
 
@@ -25,11 +25,11 @@ from .region import Region
 from .tiling import TilingUnavailable
 
 #: Work budget of the improvement stage when none is given, in reference seconds: 7 s up to
-#: 2,000 targets, 2.8 ms more per target above, at most 60 s (29 s at 1e4 targets).
+#: 2,000 targets, 2.8 ms more per target above, at most 30 s (29 s at 1e4 targets).
 DEFAULT_TIME_LIMIT_S = 7.0
 _DEFAULT_PER_TARGET_S = 0.0028
 _DEFAULT_FROM_TARGETS = 2000
-_DEFAULT_MAX_S = 60.0
+_DEFAULT_MAX_S = 30.0
 
 
 def default_time_limit_s(targets: int) -> float:
@@ -37,9 +37,10 @@ def default_time_limit_s(targets: int) -> float:
     extra = max(0, targets - _DEFAULT_FROM_TARGETS) * _DEFAULT_PER_TARGET_S
     return min(DEFAULT_TIME_LIMIT_S + extra, _DEFAULT_MAX_S)
 
-#: Above this many targets the Dubins nearest neighbour is not run: it is the slowest peer
-#: there (30 s at 1e5) and measured 3 to 6 times longer than the best (docs/benchmarks.md).
-NEAREST_MAX_TARGETS = 20_000
+#: Above this many targets the Dubins nearest neighbour and the headings planner are not run:
+#: there they are the slowest peers (30 s and 8 s at 1e5) and measured 3 to 6 times longer
+#: than the best (docs/benchmarks-scaling.md).
+SLOW_PEERS_MAX_TARGETS = 20_000
 
 
 class AutoPlanner(Planner):
@@ -66,8 +67,9 @@ class AutoPlanner(Planner):
         failures: list[DtspError] = []
         for planner in (AlternatingPlanner(), HeadingsPlanner(), LanesPlanner(), NearestPlanner(),
                         RBTAPlanner(**peer_parameters)):
-            if isinstance(planner, NearestPlanner) and len(targets_m) > NEAREST_MAX_TARGETS:
-                candidates[planner.name] = f"not run above {NEAREST_MAX_TARGETS} targets"
+            if (isinstance(planner, (NearestPlanner, HeadingsPlanner))
+                    and len(targets_m) > SLOW_PEERS_MAX_TARGETS):
+                candidates[planner.name] = f"not run above {SLOW_PEERS_MAX_TARGETS} targets"
                 continue
             try:
                 tour = planner.plan(targets_m, rho_m, region)

@@ -5,7 +5,9 @@ The tour is a cyclic order of the targets with one heading per visit; its length
 the shortest Dubins lengths between consecutive visit poses.  Starting from any such tour the
 improver returns one that is never longer, by an iterated local search:
 
-* **moves** (on neighbour lists of the ``NEIGHBOURS`` nearest targets, with don't-look bits):
+* **moves** (on neighbour lists of the :func:`neighbour_count` nearest targets, with don't-look
+  bits; a move whose new legs, as straight lines, already cost more than it could gain is not
+  evaluated):
   a new heading for one visit (``HEADING_CANDIDATES`` around the circle, then golden-section
   refinement); 2-opt with heading flips (a section flown backwards with every heading turned
   by pi keeps the lengths of its inner legs, so only the two new legs are computed); Or-opt of
@@ -44,13 +46,19 @@ import numba
 import numpy as np
 
 from ..dubins.kernel import solve_pair
+from .euclidean_tour import _d as _eu          # straight distance: no Dubins path is shorter
 from .euclidean_tour import neighbour_lists, reverse_section
 from .headings import edge_directions, headings_over_candidates, straight_through_headings
 
 _JIT = dict(cache=True, error_model="numpy")
 
-#: Nearest targets whose tour edges are tried in 2-opt and Or-opt moves.
+#: Nearest targets whose tour edges are tried in 2-opt and Or-opt moves: ``NEIGHBOURS`` up to
+#: ``NEIGHBOURS_FROM`` targets, ``NEIGHBOURS_PER_DECADE`` more per tenfold above, at most
+#: ``MAX_NEIGHBOURS`` (see :func:`neighbour_count`).
 NEIGHBOURS = 8
+NEIGHBOURS_FROM = 1000
+NEIGHBOURS_PER_DECADE = 40
+MAX_NEIGHBOURS = 64
 #: Headings tried for a visit before golden-section refinement.
 HEADING_CANDIDATES = 12
 #: Headings tried for a single visit at a new place (no refinement: heading moves follow).
@@ -215,6 +223,8 @@ def _try_heading(pts, tour, pos, hd, a, count, touched, min_gain):
     """A better heading for a between its neighbours; the gain (radii), 0 if none."""
     p, s = _pred(tour, pos, a), _succ(tour, pos, a)
     current = _dist(pts, p, hd[p], a, hd[a], count) + _dist(pts, a, hd[a], s, hd[s], count)
+    if current - _eu(pts, p, a) - _eu(pts, a, s) < min_gain:
+        return 0.0, 0                     # already within min_gain of the straight lines
     h, value = _best_heading(pts, hd, p, a, s, count, HEADING_CANDIDATES, True)
     if value < current - min_gain:
         hd[a] = h
@@ -238,14 +248,19 @@ def _try_two_opt(pts, tour, pos, hd, nbr, a, count, touched):
             e = _succ(tour, pos, c) if direction == 0 else _pred(tour, pos, c)
             if e == a or e == b:
                 continue
+            # The new legs are no shorter than straight lines: skip moves that cannot gain.
             if direction == 0:      # a b ... c e  ->  a c' ... b' e
+                d_ce = _dist(pts, c, hd[c], e, hd[e], count)
+                if d_ab + d_ce - _eu(pts, a, c) - _eu(pts, b, e) <= best:
+                    continue
                 delta = (_dist(pts, a, hd[a], c, hd[c] + _PI, count)
-                         + _dist(pts, b, hd[b] + _PI, e, hd[e], count)
-                         - d_ab - _dist(pts, c, hd[c], e, hd[e], count))
+                         + _dist(pts, b, hd[b] + _PI, e, hd[e], count) - d_ab - d_ce)
             else:                   # e c ... b a  ->  e b' ... c' a
+                d_ec = _dist(pts, e, hd[e], c, hd[c], count)
+                if d_ab + d_ec - _eu(pts, e, b) - _eu(pts, c, a) <= best:
+                    continue
                 delta = (_dist(pts, e, hd[e], b, hd[b] + _PI, count)
-                         + _dist(pts, c, hd[c] + _PI, a, hd[a], count)
-                         - d_ab - _dist(pts, e, hd[e], c, hd[c], count))
+                         + _dist(pts, c, hd[c] + _PI, a, hd[a], count) - d_ab - d_ec)
             if -delta > best:
                 best, best_c, best_dir = -delta, c, direction
     if best_c < 0:
@@ -289,20 +304,26 @@ def _try_or_opt(pts, tour, pos, hd, nbr, a, count, touched):
                         continue                 # inside the section, or its own place
                     d = _succ(tour, pos, c)
                     d_cd = _dist(pts, c, hd[c], d, hd[d], count)
+                    room = d_cd + gain - best          # a move must add less than this
                     if length == 1:
+                        if _eu(pts, c, a) + _eu(pts, a, d) >= room:
+                            continue
                         h, value = _best_heading(pts, hd, c, a, d, count, INSERTION_CANDIDATES, False)
                         delta = value - d_cd - gain
                         if -delta > best:
                             best, best_len, best_c, best_flip, best_h = -delta, 1, c, False, h
                         continue
-                    forward = (_dist(pts, c, hd[c], first, hd[first], count)
-                               + _dist(pts, last, hd[last], d, hd[d], count) - d_cd - gain)
-                    flipped = (_dist(pts, c, hd[c], last, hd[last] + _PI, count)
-                               + _dist(pts, first, hd[first] + _PI, d, hd[d], count) - d_cd - gain)
-                    if -forward > best:
-                        best, best_len, best_c, best_flip = -forward, length, c, False
-                    if -flipped > best:
-                        best, best_len, best_c, best_flip = -flipped, length, c, True
+                    if _eu(pts, c, first) + _eu(pts, last, d) < room:
+                        forward = (_dist(pts, c, hd[c], first, hd[first], count)
+                                   + _dist(pts, last, hd[last], d, hd[d], count) - d_cd - gain)
+                        if -forward > best:
+                            best, best_len, best_c, best_flip = -forward, length, c, False
+                            room = d_cd + gain - best
+                    if _eu(pts, c, last) + _eu(pts, first, d) < room:
+                        flipped = (_dist(pts, c, hd[c], last, hd[last] + _PI, count)
+                                   + _dist(pts, first, hd[first] + _PI, d, hd[d], count) - d_cd - gain)
+                        if -flipped > best:
+                            best, best_len, best_c, best_flip = -flipped, length, c, True
     if best_c < 0:
         return 0.0, 0
     i = pos[a]
@@ -543,6 +564,21 @@ class Improvement:
     moves: int = 0
 
 
+def neighbour_count(n: int) -> int:
+    """Neighbours per target the moves try for a tour of ``n`` targets.
+
+    Measured (uniform 5 km square, rho 100 m, default budget): 8 is the best or level with the
+    best up to 1,000 targets and on the dense, clustered and bundled sites of 100-420; above,
+    the lanes the tours start from are narrow and the place a looping target fits is beyond
+    the nearest eight (n = 1e4: 1.99 x the lower bound with 8, 1.59 with 48; n = 1e5, 30 s:
+    2.41 with 32, 2.25 with 48, 2.18 with 64).
+    """
+    if n <= NEIGHBOURS_FROM:
+        return NEIGHBOURS
+    extra = NEIGHBOURS_PER_DECADE * math.log10(n / NEIGHBOURS_FROM)
+    return int(min(MAX_NEIGHBOURS, round(NEIGHBOURS + extra)))
+
+
 def _optimise_headings(pts: np.ndarray, tour: np.ndarray, hd: np.ndarray, grid: int = 12,
                        sweeps: int = 3, keep_current: bool = True) -> np.ndarray:
     """Headings (by target) over the visiting order ``tour``: exact over ``grid`` + 2 discrete
@@ -580,7 +616,7 @@ def improve_tour(points_m: np.ndarray, order: np.ndarray, headings_rad: np.ndarr
     if n < 4 or budget <= 0:
         return Improvement(tour, hd[tour], start * rho_m, start * rho_m, int(count[0]), budget,
                            "too few targets" if n < 4 else "budget")
-    nbr = neighbour_lists(points, min(NEIGHBOURS, n - 1))
+    nbr = neighbour_lists(points, min(neighbour_count(n), n - 1))
     best_tour, best_hd = tour.copy(), hd.copy()
     best = np.array([start])
     state = np.zeros(2, dtype=np.int64)       # kicks since the best improved, kicks in all

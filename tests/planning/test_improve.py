@@ -69,6 +69,72 @@ def test_the_moves_account_for_the_length_they_change_exactly(n):
             after = im.tour_length_rho(points, tour, headings, count)
 
 
+def _dubins(points, a, ha, b, hb):
+    return im._dist(points, a, ha, b, hb, np.zeros(1, np.int64))
+
+
+@pytest.mark.parametrize("seed", range(6))
+def test_moves_skipped_on_straight_line_bounds_are_never_the_best(seed):
+    """The 2-opt and heading searches skip candidates whose new legs, as straight lines,
+    already cost more than the best gain so far: what they return is still the best move
+    among all their candidates, found here by evaluating every one."""
+    rng = np.random.default_rng(seed)
+    n = 30
+    points = rng.uniform(0, 4, (n, 2))              # radii: close targets, many loops
+    tour = rng.permutation(n).astype(np.int64)
+    headings = rng.uniform(-np.pi, np.pi, n)
+    position = np.empty(n, dtype=np.int64)
+    position[tour] = np.arange(n)
+    neighbours = neighbour_lists(points, 8)
+    succ = lambda v: tour[(position[v] + 1) % n]                                  # noqa: E731
+    pred = lambda v: tour[(position[v] - 1) % n]                                  # noqa: E731
+    for a in range(n):
+        best = 1e-9                                  # the improver's smallest move
+        for forward in (True, False):
+            b = succ(a) if forward else pred(a)
+            for c in neighbours[a]:
+                e = succ(c) if forward else pred(c)
+                if c in (a, b) or e in (a, b):
+                    continue
+                if forward:
+                    delta = (_dubins(points, a, headings[a], c, headings[c] + np.pi)
+                             + _dubins(points, b, headings[b] + np.pi, e, headings[e])
+                             - _dubins(points, a, headings[a], b, headings[b])
+                             - _dubins(points, c, headings[c], e, headings[e]))
+                else:
+                    delta = (_dubins(points, e, headings[e], b, headings[b] + np.pi)
+                             + _dubins(points, c, headings[c] + np.pi, a, headings[a])
+                             - _dubins(points, b, headings[b], a, headings[a])
+                             - _dubins(points, e, headings[e], c, headings[c]))
+                best = max(best, -delta)
+        trial_tour, trial_position, trial_headings = tour.copy(), position.copy(), headings.copy()
+        gain, moved = im._try_two_opt(points, trial_tour, trial_position, trial_headings,
+                                      neighbours, a, np.zeros(3, np.int64), np.empty(8, np.int64))
+        assert gain == pytest.approx(best if best > 1e-9 else 0.0, abs=1e-9)
+        assert (moved > 0) == (best > 1e-9)
+        # A heading search that gives up on the straight-line bound could not have gained.
+        p, s = pred(a), succ(a)
+        current = (_dubins(points, p, headings[p], a, headings[a])
+                   + _dubins(points, a, headings[a], s, headings[s]))
+        gain, moved = im._try_heading(points, tour.copy(), position.copy(), headings.copy(), a,
+                                      np.zeros(3, np.int64), np.empty(8, np.int64), im.HEADING_MIN_GAIN)
+        if moved == 0:
+            grid = np.linspace(-np.pi, np.pi, 721)
+            cheapest = min(_dubins(points, p, headings[p], a, h) + _dubins(points, a, h, s, headings[s])
+                           for h in grid)
+            straight = np.hypot(*(points[a] - points[p])) + np.hypot(*(points[s] - points[a]))
+            assert cheapest >= straight - 1e-9
+            if current - straight < im.HEADING_MIN_GAIN:
+                assert current - cheapest < im.HEADING_MIN_GAIN
+
+
+def test_more_targets_get_longer_neighbour_lists():
+    counts = [im.neighbour_count(n) for n in (4, 400, 1000, 2000, 10_000, 100_000, 10**7)]
+    assert counts[:3] == [im.NEIGHBOURS] * 3
+    assert counts == sorted(counts) and counts[-1] == im.MAX_NEIGHBOURS
+    assert counts[3] > im.NEIGHBOURS
+
+
 @pytest.mark.parametrize("family,n", [("uniform", 30), ("dense", 40), ("clustered", 40)])
 def test_the_improved_tour_is_checked_and_never_longer(family, n):
     points = instance(family, n, 3)
