@@ -70,17 +70,19 @@ LIMITS = """
   between close targets -- the fence corners and pylon-line ends of the bundled site) get a
   waypoint every quarter turn from the start; without them ArduPlane cut inside every loop the
   wrong way round and missed the targets after it by 10-55 m (bundled site: 41 targets beyond
-  5 m at 1.01 items per target, the predicted flight 21 % shorter than the exact path; now 16
-  at 1.22, 3.6 % shorter).
-- What is left on the bundled site: the ends of the pylon lines, where a loop closes back onto
-  the line within ArduPlane's L1 distance (about 79 m at 22 m/s): the guidance is still
-  settling when it reaches the next pylons (worst 13.8 m).
-- Clustered sites (Gaussian clusters, sigma 150 m): 2 of 100 and 18 of 400 targets beyond 5 m,
-  at 1.61 and 1.64 items per target; the 400-target site is held back by the 655-item budget
-  (the shaping waypoints that would hold the rest do not fit; its worst target, 44.5 m, is in
-  a cluster the budget left unshaped). A mission that does not fit at all is split into
-  sorties (`plan` writes `mission-1.plan`, ...; `docs/missions.md`); a design that fits but is
-  budget-bound is not split.
+  5 m at 1.01 items per target, the predicted flight 21 % shorter than the exact path).
+- The repair keeps a round only when the model predicts it better (waypoints closer than the
+  L1 distance pull each other's tracks: corrected all at once they overshoot together, and the
+  earlier repair, which kept every round, diverged after its third flight on the bundled
+  site). Measured on the same tours, before -> after: bundled 17 -> 12 targets beyond 5 m,
+  clustered 100 5 -> 2, dense 200 9 -> 2.
+- What is left on the bundled site: the pylon lines, targets 40-50 m apart (closer than
+  ArduPlane's L1 distance, about 79 m at 22 m/s) right after a loop closes back onto the line:
+  the guidance is still settling when it reaches the next pylons (worst 13.7 m).
+- The 400-target clustered site: 24 targets beyond 5 m at 1.32 items per target -- the design
+  runs out of predicted flights (50), not of items (100 flights: 15 beyond at 1.53 items per
+  target, twice the time). A mission that does not fit at all is split into sorties (`plan`
+  writes `mission-1.plan`, ...; `docs/missions.md`).
 - The design trusts the flight model: its agreement with real ArduPlane flights is measured in
   `arduplane-agreement.md` (closest approach within about 1 m of ArduPlane's on the recorded
   dtsp-mission missions); nothing here was flown by a real ArduPlane.

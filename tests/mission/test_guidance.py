@@ -86,11 +86,12 @@ def _fence(rho_m: float):
 def test_loops_of_the_exact_path_get_waypoints_and_are_flown_round(monkeypatch):
     """ArduPlane given only a loop's ends cuts inside it, the wrong way round, and misses the
     posts after it (the bundled site's fence corners); waypoints on the loop make it fly the
-    loop: fewer targets beyond the limit, a smaller worst miss, a predicted flight closer to
-    the planned one."""
+    loop: as first designed (one predicted flight, before any repair), fewer targets beyond
+    the limit, a smaller worst miss, a predicted flight closer to the planned one."""
     import dtsp_mission.mission.guidance as guidance
     tour, frame, targets = _fence(104.0)
     settings = MissionSettings(design="guidance", airspeed_m_s=22.0, altitude_m=120.0)
+    monkeypatch.setattr(guidance, "ROUNDS", 1)
     looped = build_mission(tour, frame, targets, settings)
     monkeypatch.setattr(guidance, "LOOP_MIN_RAD", float("inf"))
     bare = build_mission(tour, frame, targets, settings)
@@ -102,4 +103,23 @@ def test_loops_of_the_exact_path_get_waypoints_and_are_flown_round(monkeypatch):
     beyond, worst, off = figures(looped)
     beyond_bare, worst_bare, off_bare = figures(bare)
     assert beyond < beyond_bare and worst < worst_bare and off < off_bare
-    assert looped.summary["items"] <= bare.summary["items"]
+    assert looped.summary["items"] > bare.summary["items"]          # the loop waypoints
+
+
+def test_the_repair_keeps_only_what_the_model_flew_better(monkeypatch):
+    """The repair rounds never return a design the model predicts worse than the first one,
+    and on the fence they hold more posts than it."""
+    import dtsp_mission.mission.guidance as guidance
+    tour, frame, targets = _fence(104.0)
+    settings = MissionSettings(design="guidance", airspeed_m_s=22.0, altitude_m=120.0)
+
+    def excess(mission):
+        miss = np.array(mission.summary["predicted_miss_m"])
+        return float(np.maximum(miss - settings.max_miss_m, 0.0).sum()), int((miss > 5.0).sum())
+    repaired = build_mission(tour, frame, targets, settings)
+    limit = guidance.ROUNDS
+    monkeypatch.setattr(guidance, "ROUNDS", 1)
+    first = build_mission(tour, frame, targets, settings)
+    assert excess(repaired)[0] < excess(first)[0] and excess(repaired)[1] < excess(first)[1]
+    assert 1 < repaired.summary["design_rounds"] <= limit
+    assert first.summary["design_rounds"] == 1
