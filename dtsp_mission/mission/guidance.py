@@ -17,11 +17,11 @@ checked against recorded ArduPlane flights) and repairing what it misses:
    ``AFFECTS_NEXT``) are flown alone; if that does not help either, the next round tries half
    the corrections (waypoints closer than the L1 distance pull each other's tracks, so full
    corrections of neighbours overshoot together);
-4. when even small corrections no longer help, each target still beyond gets a shaping
-   waypoint on the exact path before it (in the longest waypoint gap within ``LOOKBACK_L1``),
-   kept where it helped;
+4. after ``IDLE_ROUNDS`` rounds in a row that gain less than ``PROGRESS``, each target still
+   beyond gets a shaping waypoint on the exact path before it (in the longest waypoint gap
+   within ``LOOKBACK_L1``) and the corrections go on from there;
 5. repeat until every target holds or the predicted flights (``ROUNDS``) or the item budget
-   are spent.
+   are spent; the best design flown is returned.
 
 Guarantee: the returned design says, per target, the predicted miss; nothing is claimed that
 the model did not fly.
@@ -31,6 +31,7 @@ from __future__ import annotations
 
 import math
 from dataclasses import dataclass
+from typing import Callable
 
 import numpy as np
 
@@ -190,11 +191,12 @@ class _Trial:
         return float(self.excess.sum())
 
 
-def _with_shaping(best: _Trial, targets: list[int], lookback_m: float,
-                  loiter_ends: dict[float, float], fly) -> _Trial:
-    """``best`` flown again with a shaping waypoint before each of ``targets`` (their aims
+def _with_shaping(trial: _Trial, targets: list[int], lookback_m: float,
+                  loiter_ends: dict[float, float],
+                  fly: Callable[[list[float], list[int], dict[int, np.ndarray]], _Trial]) -> _Trial:
+    """``trial`` flown again with a shaping waypoint before each of ``targets`` (their aims
     reset onto the targets)."""
-    s_wp, target_of, offsets = list(best.s_wp), list(best.target_of), dict(best.offsets)
+    s_wp, target_of, offsets = list(trial.s_wp), list(trial.target_of), dict(trial.offsets)
     chosen = set(targets)
     insert = sorted({_shaping_gap(s_wp, k, lookback_m, loiter_ends)
                      for k, t in enumerate(target_of) if t in chosen}, reverse=True)
