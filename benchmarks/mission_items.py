@@ -74,14 +74,15 @@ LIMITS = """
 - The repair keeps a round only when the model predicts it better (waypoints closer than the
   L1 distance pull each other's tracks: corrected all at once they overshoot together, and the
   earlier repair, which kept every round, diverged after its third flight on the bundled
-  site). Measured on the same tours, before -> after: bundled 17 -> 12 targets beyond 5 m,
-  clustered 100 5 -> 2, dense 200 9 -> 2.
+  site); a target beyond 5 m counts as missed by 5 m more. Measured on the same tours, before
+  -> after: bundled 17 -> 11 targets beyond 5 m, clustered 100 5 -> 1, dense 200 9 -> 2,
+  uniform 100 (rho 80) 4 -> 0.
 - What is left on the bundled site: the pylon lines, targets 40-50 m apart (closer than
   ArduPlane's L1 distance, about 79 m at 22 m/s) right after a loop closes back onto the line:
   the guidance is still settling when it reaches the next pylons (worst 13.7 m).
-- The 400-target clustered site: 24 targets beyond 5 m at 1.32 items per target -- the design
-  runs out of predicted flights (50), not of items (100 flights: 15 beyond at 1.53 items per
-  target, twice the time). A mission that does not fit at all is split into sorties (`plan`
+- The 400-target clustered site: 16 targets beyond 5 m at 1.31 items per target -- the design
+  runs out of predicted flights (50), not of items (100 flights: 9 beyond at 1.38 items per
+  target, but a worst miss of 46 m, in twice the time). A mission that does not fit at all is split into sorties (`plan`
   writes `mission-1.plan`, ...; `docs/missions.md`).
 - The design trusts the flight model: its agreement with real ArduPlane flights is measured in
   `arduplane-agreement.md` (closest approach within about 1 m of ArduPlane's on the recorded
