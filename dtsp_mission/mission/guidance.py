@@ -13,11 +13,10 @@ checked against recorded ArduPlane flights) and repairing what it misses:
    ``CORRECT_ABOVE`` of ``max_miss_m`` has its waypoint moved by the miss (the aim point:
    where the autopilot must be sent so that it passes over the target);
 3. the round is kept only if the total miss beyond ``max_miss_m`` (each target beyond counted
-   ``BEYOND_COST`` of it more) shrinks; if not, the
-   corrections that did not hurt where they act (their target and the next
-   ``AFFECTS_NEXT``) are flown alone; if that does not help either, the next round tries half
-   the corrections (waypoints closer than the L1 distance pull each other's tracks, so full
-   corrections of neighbours overshoot together);
+   ``BEYOND_COST`` of it more) shrinks; if not, the corrections that did not hurt where they
+   act (their target and the next ``AFFECTS_NEXT``) are flown alone; if that does not help
+   either, the next round tries half the corrections (waypoints closer than the L1 distance
+   pull each other's tracks, so full corrections of neighbours overshoot together);
 4. after ``IDLE_ROUNDS`` rounds in a row that gain less than ``PROGRESS``, each target still
    beyond gets a shaping waypoint on the exact path before it (in the longest waypoint gap
    within ``LOOKBACK_L1``) and the corrections go on from there;
@@ -58,8 +57,9 @@ AFFECTS_NEXT = 2
 #: on the mission-items sites, about 3 s more on the bundled site).
 ROUNDS = 50
 #: A target beyond the allowed miss counts as missed by this fraction of the allowed miss more
-#: (measured: with 1 instead of 0, 15 instead of 17 targets beyond 5 m on four sites of 100-272
-#: targets, 16 instead of 24 on the 400-target clustered site; the worst miss 29.8 against 27.6 m).
+#: (measured on the eight sites of docs/mission-items.md: 1 instead of 0 leaves 31 instead of 41
+#: targets beyond 5 m, 16 instead of 24 on the 400-target clustered site, whose worst miss is
+#: 28.1 against 27.6 m).
 BEYOND_COST = 1.0
 #: A shaping waypoint goes into the longest stretch of the exact path among the waypoint gaps
 #: this many L1 distances before the stuck target: where the path turns that the autopilot
@@ -283,7 +283,7 @@ def design_waypoints(path: FlightPath, targets_m: np.ndarray, altitudes_m: np.nd
                       np.maximum(miss - max_miss_m, 0.0), corrections, max_miss_m)
 
     def local(trial: _Trial, t: int) -> float:
-        """Excess at target t and the next targets it affects (visit order)."""
+        """Cost at target t and the next targets it affects (visit order)."""
         k = rank[t]
         return float(trial.cost[order[k:k + AFFECTS_NEXT + 1]].sum())
 
