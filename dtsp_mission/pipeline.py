@@ -22,7 +22,7 @@ from .dubins.path import check_radius
 from .errors import InputError, MissionTooLarge
 from .frame import LocalFrame, mission_centre
 from .mission import Mission, MissionSettings, build_mission
-from .mission.build import targets_beyond, with_turn_margin
+from .mission.build import GUIDANCE_MARGINS, targets_beyond, with_turn_margin
 from .mission.sorties import Sortie, split_into_sorties
 from .planning import TilingUnavailable, get_planner
 from .planning.lower_bounds import LowerBound, lower_bound
@@ -141,8 +141,10 @@ def _bound(positions: np.ndarray, rho_m: float, area_m: np.ndarray | None) -> Lo
 
 
 def run_plan(request: PlanRequest,
-             progress: Callable[[float], None] | None = None) -> PlanResult:
-    """Plan ``request``: every stage in order, ``progress(fraction)`` while the tour improves.
+             progress: Callable[[float], None] | None = None,
+             design_progress: Callable[[float], None] | None = None) -> PlanResult:
+    """Plan ``request``: every stage in order, ``progress(fraction)`` while the tour improves
+    and ``design_progress(fraction)`` while the guidance design flies its predictions.
 
     Guarantees: the tour passed the geometry checker; a mission (or each sortie's) fits the
     vehicle's storage; what was decided on the user's behalf is in ``notes``.  Bad input is an
@@ -171,16 +173,20 @@ def run_plan(request: PlanRequest,
     result = PlanResult(local, geodetic, frame, tour, time.perf_counter() - started, area_m,
                         notes=notes)
     if request.settings is not None:
-        _design_mission(request, result)
+        _design_mission(request, result, design_progress)
     return result
 
 
-def _design_mission(request: PlanRequest, result: PlanResult) -> None:
+def _design_mission(request: PlanRequest, result: PlanResult,
+                    progress: Callable[[float], None] | None = None) -> None:
     """The mission stage: build, widen the turns for the guidance, split where needed."""
     settings, frame, geodetic, tour = request.settings, result.frame, result.geodetic, result.tour
     endurance_s = request.endurance_s
+    share = 1.0 / (1 + len(GUIDANCE_MARGINS))     # the first design's part of the work
+    first = None if progress is None else lambda done, total: progress(share * done / total)
+    widening = None if progress is None else lambda fraction: progress(share + (1 - share) * fraction)
     try:
-        mission = build_mission(tour, frame, geodetic, settings)
+        mission = build_mission(tour, frame, geodetic, settings, first)
     except MissionTooLarge as error:
         if request.too_large == "raise":
             raise
@@ -193,7 +199,7 @@ def _design_mission(request: PlanRequest, result: PlanResult) -> None:
     if "predicted_miss_m" in mission.summary:
         replan = lambda rho: plan_tour_in(result.local.positions_m, rho, request.algorithm,  # noqa: E731
                                           request.parameters, request.fallback)
-        widened = with_turn_margin(mission, replan, geodetic, settings)
+        widened = with_turn_margin(mission, replan, geodetic, settings, widening)
         if widened is not mission:
             result.notes.append(
                 f"planned with a turn radius of {widened.rho_m:g} m instead of "

@@ -68,3 +68,16 @@ def test_sorties_are_planned_with_wider_turns_where_the_guidance_needs_them():
     for sortie in widened:
         assert sortie.mission.vehicle_item_count() <= 40
         assert sum(i.role == "target" for i in sortie.mission.items) == len(sortie.targets)
+
+
+def test_the_guidance_design_reports_its_progress_in_order():
+    """The design flies up to 50 predictions per turn radius tried: the pipeline reports the
+    share of that work done, rising, within 0..1, and the tour's own progress separately."""
+    targets = _site(30)
+    settings = MissionSettings(design="guidance", airspeed_m_s=22.0, altitude_m=120.0)
+    tour_steps, design_steps = [], []
+    result = run_plan(PlanRequest(targets, 80.0, "auto", {"time_limit_s": 0.2}, origin=(46.8, 6.95),
+                                  settings=settings), tour_steps.append, design_steps.append)
+    assert result.mission is not None and tour_steps and design_steps
+    assert design_steps == sorted(design_steps) and 0.0 < design_steps[0] and design_steps[-1] <= 1.0
+    assert result.mission.summary["design_rounds"] >= 1

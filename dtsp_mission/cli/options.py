@@ -209,7 +209,9 @@ def progress_reporter(label: str):
         state["done"] = done
 
     def close() -> None:
-        if "bar" in state:
-            state["bar"].__exit__(None, None, None)
+        """End the bar (once: closing again does nothing)."""
+        bar = state.pop("bar", None)
+        if bar is not None:
+            bar.__exit__(None, None, None)
 
     return progress, close

@@ -218,10 +218,17 @@ def plan(targets_file, random_count, area_file, seed, origin, rho_m, airspeed_m_
              "once; later runs start at once)")
     say(f"{len(targets)} targets; {rho_source}")
     progress, close_progress = progress_reporter("improving the tour")
+    designing, close_designing = progress_reporter("designing the waypoints for the guidance")
+
+    def design_progress(fraction: float) -> None:
+        close_progress()                    # the tour is done: its bar ends before this one
+        designing(int(1000 * fraction), 1000)
     try:
-        result = run_plan(request, lambda fraction: progress(int(1000 * fraction), 1000))
+        result = run_plan(request, lambda fraction: progress(int(1000 * fraction), 1000),
+                          design_progress)
     finally:
         close_progress()
+        close_designing()
     record(targets=len(result.local), rho_m=rho)
     _report(result, settings, airspeed_m_s)
     product = result.product

@@ -164,7 +164,8 @@ def _fit_waypoints(path: FlightPath, rho_m: float, settings: MissionSettings,
 
 
 def _design_for_guidance(path: FlightPath, tour: Tour, frame: LocalFrame, targets: GeoTargets,
-                         settings: MissionSettings, actions: int = 0) -> GuidanceDesign:
+                         settings: MissionSettings, actions: int = 0,
+                         progress: Callable[[int, int], None] | None = None) -> GuidanceDesign:
     """Waypoints for ArduPlane's guidance (:mod:`.guidance`) within the item budget; the
     lead-out of a landing stays a geometric polyline."""
     parameters = settings.vehicle or ARDUPLANE_DEFAULTS
@@ -185,7 +186,7 @@ def _design_for_guidance(path: FlightPath, tour: Tour, frame: LocalFrame, target
                  else np.asarray(targets.altitudes_m, dtype=float))
     altitudes = np.where(np.isnan(altitudes), settings.altitude_m, altitudes)   # not given
     design = design_waypoints(path, tour.targets_m, altitudes, airframe, settings.max_miss_m, budget, head,
-                              settings.target_acceptance_m)
+                              settings.target_acceptance_m, progress=progress)
     return replace(design, s_m=np.concatenate([[0.0], design.s_m, tail]),
                    aim_m=np.vstack([path.chain.pose_at(np.array([0.0]))[:, :2], design.aim_m,
                                     path.chain.pose_at(tail)[:, :2].reshape(-1, 2)]),
@@ -201,12 +202,14 @@ def _tail_waypoints(path: FlightPath, rho_m: float, settings: MissionSettings) -
 
 
 def build_mission(tour: Tour, frame: LocalFrame, targets: GeoTargets,
-                  settings: MissionSettings) -> Mission:
+                  settings: MissionSettings,
+                  progress: Callable[[int, int], None] | None = None) -> Mission:
     """The mission that flies ``tour`` (planned in ``frame``) from take-off to the return.
 
     Guarantees: the waypoint polyline stays within the reported tolerance of the exact flight
     path; every target is one NAV_WAYPOINT at its own coordinates; the item count fits
     ``max_items`` (with ArduPilot's home slot) or :class:`InputError` says how many are needed.
+    ``progress(flights, rounds)`` follows the guidance design's predicted flights.
     """
     settings = settings.checked(tour.rho_m)
     notes: list[str] = []
@@ -248,7 +251,8 @@ def build_mission(tour: Tour, frame: LocalFrame, targets: GeoTargets,
                      "navigation, and PX4's is not modelled")
         settings = replace(settings, design="geometry")
     if settings.design == "guidance":
-        design = _design_for_guidance(path, tour, frame, targets, settings, at_targets.count)
+        design = _design_for_guidance(path, tour, frame, targets, settings, at_targets.count,
+                                      progress)
         chosen, tolerance = design.s_m, float("nan")
         held = design.predicted_miss_m <= settings.max_miss_m
         if not held.all():
@@ -424,20 +428,24 @@ def targets_beyond(mission: Mission, max_miss_m: float) -> int:
 
 
 def with_turn_margin(mission: Mission, replan: Callable[[float], Tour], targets: GeoTargets,
-                     settings: MissionSettings) -> Mission:
+                     settings: MissionSettings,
+                     progress: Callable[[float], None] | None = None) -> Mission:
     """``mission`` (guidance design), or the mission of a tour planned with a wider turn radius
     (``replan(rho)``, :data:`GUIDANCE_MARGINS`) if that holds more targets within
-    ``settings.max_miss_m`` (ties: the shorter predicted flight)."""
+    ``settings.max_miss_m`` (ties: the shorter predicted flight).  ``progress(fraction)``
+    follows the designs' predicted flights (at most; it stops early when a design holds)."""
     def key(candidate: Mission) -> tuple[int, float]:
         return (targets_beyond(candidate, settings.max_miss_m),
                 candidate.summary["predicted_flight_m"])
     best = mission
-    for factor in GUIDANCE_MARGINS:
+    for index, factor in enumerate(GUIDANCE_MARGINS):
         if targets_beyond(best, settings.max_miss_m) == 0:
             break
+        step = (None if progress is None else
+                lambda done, total, index=index: progress((index + done / total) / len(GUIDANCE_MARGINS)))
         try:
             candidate = build_mission(replan(mission.rho_m * factor), mission.frame, targets,
-                                      settings)
+                                      settings, step)
         except DtspError:
             continue
         if key(candidate) < key(best):

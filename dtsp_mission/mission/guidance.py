@@ -223,7 +223,8 @@ def _with_shaping(trial: _Trial, targets: list[int], lookback_m: float,
 def design_waypoints(path: FlightPath, targets_m: np.ndarray, altitudes_m: np.ndarray,
                      airframe: Airframe, max_miss_m: float, budget: int,
                      head_items: list[tuple[int, tuple[float, float, float, float]]] = (),
-                     target_acceptance_m: float = 5.0, rounds: int | None = None) -> GuidanceDesign:
+                     target_acceptance_m: float = 5.0, rounds: int | None = None,
+                     progress: Callable[[int, int], None] | None = None) -> GuidanceDesign:
     """The waypoints (``budget`` at most) that make the modelled autopilot pass every target
     of ``path`` within ``max_miss_m``, as far as ``rounds`` predicted flights allow.
 
@@ -231,7 +232,8 @@ def design_waypoints(path: FlightPath, targets_m: np.ndarray, altitudes_m: np.nd
     above home; ``head_items`` are the (command, params) of the items flown between the take-off
     and the first waypoint (DO_CHANGE_SPEED).  The flight starts at the path's climb start
     (home) facing the start of the path.  The design returned is the best flown (least
-    :attr:`_Trial.total`): a round that makes it worse is never kept.
+    :attr:`_Trial.total`): a round that makes it worse is never kept.  ``progress(flights,
+    rounds)`` is called after each predicted flight.
     """
     home = path.climb_start_m
     order = np.argsort(path.target_s_m, kind="stable")
@@ -251,9 +253,13 @@ def design_waypoints(path: FlightPath, targets_m: np.ndarray, altitudes_m: np.nd
     takeoff_alt = float(path.altitude_m(np.array([0.0]))[0])
     flights = 0
 
+    rounds = ROUNDS if rounds is None else rounds
+
     def fly(s_wp: list[float], target_of: list[int], offsets: dict[int, np.ndarray]) -> _Trial:
         nonlocal flights
         flights += 1
+        if progress is not None:
+            progress(flights, rounds)
         exact = path.chain.pose_at(np.asarray(s_wp))[:, :2]
         aim = np.array([targets_m[t] + offsets[t] if t >= 0 else exact[k]
                         for k, t in enumerate(target_of)])
@@ -291,7 +297,6 @@ def design_waypoints(path: FlightPath, targets_m: np.ndarray, altitudes_m: np.nd
     rank[order] = np.arange(len(order))
     best = current = fly(s_wp, target_of, {int(t): np.zeros(2) for t in order})
     step, idle = 1.0, 0
-    rounds = ROUNDS if rounds is None else rounds
     while best.total > 0.0 and flights < rounds:
         # Aim corrections (a fraction ``step`` of each), from the current design.
         proposal = dict(current.offsets)
