@@ -182,11 +182,14 @@ def _design_mission(request: PlanRequest, result: PlanResult,
     """The mission stage: build, widen the turns for the guidance, split where needed."""
     settings, frame, geodetic, tour = request.settings, result.frame, result.geodetic, result.tour
     endurance_s = request.endurance_s
-    share = 1.0 / (1 + len(GUIDANCE_MARGINS))     # the first design's part of the work
-    first = None if progress is None else lambda done, total: progress(share * done / total)
-    widening = None if progress is None else lambda fraction: progress(share + (1 - share) * fraction)
+    designs = 1 + len(GUIDANCE_MARGINS)            # at most: the radius asked for, then wider
+
+    def design_step(k: int) -> Callable[[int, int], None]:
+        """Progress of the k-th design, as its share of all the designs' flights."""
+        return lambda done, total: progress((k + done / total) / designs)
     try:
-        mission = build_mission(tour, frame, geodetic, settings, first)
+        mission = build_mission(tour, frame, geodetic, settings,
+                                None if progress is None else design_step(0))
     except MissionTooLarge as error:
         if request.too_large == "raise":
             raise
@@ -199,7 +202,8 @@ def _design_mission(request: PlanRequest, result: PlanResult,
     if "predicted_miss_m" in mission.summary:
         replan = lambda rho: plan_tour_in(result.local.positions_m, rho, request.algorithm,  # noqa: E731
                                           request.parameters, request.fallback)
-        widened = with_turn_margin(mission, replan, geodetic, settings, widening)
+        widened = with_turn_margin(mission, replan, geodetic, settings,
+                                   None if progress is None else design_step)
         if widened is not mission:
             result.notes.append(
                 f"planned with a turn radius of {widened.rho_m:g} m instead of "

@@ -429,11 +429,11 @@ def targets_beyond(mission: Mission, max_miss_m: float) -> int:
 
 def with_turn_margin(mission: Mission, replan: Callable[[float], Tour], targets: GeoTargets,
                      settings: MissionSettings,
-                     progress: Callable[[float], None] | None = None) -> Mission:
+                     progress: Callable[[int], Callable[[int, int], None]] | None = None) -> Mission:
     """``mission`` (guidance design), or the mission of a tour planned with a wider turn radius
     (``replan(rho)``, :data:`GUIDANCE_MARGINS`) if that holds more targets within
-    ``settings.max_miss_m`` (ties: the shorter predicted flight).  ``progress(fraction)``
-    follows the designs' predicted flights (at most; it stops early when a design holds)."""
+    ``settings.max_miss_m`` (ties: the shorter predicted flight).  ``progress(k)`` gives the
+    progress callback of the k-th design tried (``mission``'s was the 0th)."""
     def key(candidate: Mission) -> tuple[int, float]:
         return (targets_beyond(candidate, settings.max_miss_m),
                 candidate.summary["predicted_flight_m"])
@@ -441,11 +441,9 @@ def with_turn_margin(mission: Mission, replan: Callable[[float], Tour], targets:
     for index, factor in enumerate(GUIDANCE_MARGINS):
         if targets_beyond(best, settings.max_miss_m) == 0:
             break
-        step = (None if progress is None else
-                lambda done, total, index=index: progress((index + done / total) / len(GUIDANCE_MARGINS)))
         try:
             candidate = build_mission(replan(mission.rho_m * factor), mission.frame, targets,
-                                      settings, step)
+                                      settings, None if progress is None else progress(index + 1))
         except DtspError:
             continue
         if key(candidate) < key(best):

@@ -188,15 +188,14 @@ class _Trial:
     target_of: list[int]
     offsets: dict[int, np.ndarray]
     design: GuidanceDesign
-    excess: np.ndarray               # per target (input order): miss beyond max_miss_m
+    cost: np.ndarray                 # per target (input order): what the repair minimises
     corrections: dict[int, np.ndarray]   # per target: where the track should have been moved
-    limit_m: float                       # max_miss_m
 
-    @property
-    def cost(self) -> np.ndarray:
-        """Per target, what the repair minimises: its miss beyond the limit, and
-        ``BEYOND_COST`` of the limit if it is beyond."""
-        return self.excess + BEYOND_COST * self.limit_m * (self.excess > 0.0)
+    @staticmethod
+    def cost_of(miss_m: np.ndarray, max_miss_m: float) -> np.ndarray:
+        """Per target, its miss beyond ``max_miss_m`` and ``BEYOND_COST`` of it if beyond."""
+        excess = np.maximum(miss_m - max_miss_m, 0.0)
+        return excess + BEYOND_COST * max_miss_m * (excess > 0.0)
 
     @property
     def total(self) -> float:
@@ -251,9 +250,10 @@ def design_waypoints(path: FlightPath, targets_m: np.ndarray, altitudes_m: np.nd
                for span in path.loiters}
     loiter_ends = {float(span.start_s_m): float(span.end_s_m) for span in path.loiters}
     takeoff_alt = float(path.altitude_m(np.array([0.0]))[0])
-    flights = 0
-
     rounds = ROUNDS if rounds is None else rounds
+    rank = np.empty(len(order), dtype=int)          # each target's place in the visit order
+    rank[order] = np.arange(len(order))
+    flights = 0
 
     def fly(s_wp: list[float], target_of: list[int], offsets: dict[int, np.ndarray]) -> _Trial:
         nonlocal flights
@@ -286,15 +286,13 @@ def design_waypoints(path: FlightPath, targets_m: np.ndarray, altitudes_m: np.nd
                 window = after_takeoff
             corrections[t] = targets_m[t] - _nearest_in(flown[window], targets_m[t])
         return _Trial(list(s_wp), list(target_of), dict(offsets), design,
-                      np.maximum(miss - max_miss_m, 0.0), corrections, max_miss_m)
+                      _Trial.cost_of(miss, max_miss_m), corrections)
 
     def local(trial: _Trial, t: int) -> float:
         """Cost at target t and the next targets it affects (visit order)."""
         k = rank[t]
         return float(trial.cost[order[k:k + AFFECTS_NEXT + 1]].sum())
 
-    rank = np.empty(len(order), dtype=int)
-    rank[order] = np.arange(len(order))
     best = current = fly(s_wp, target_of, {int(t): np.zeros(2) for t in order})
     step, idle = 1.0, 0
     while best.total > 0.0 and flights < rounds:
@@ -320,7 +318,7 @@ def design_waypoints(path: FlightPath, targets_m: np.ndarray, altitudes_m: np.nd
             continue
         # Corrections no longer help: a shaping waypoint before each target still beyond;
         # the corrections go on from there (the best design flown is kept).
-        beyond = [int(t) for t in np.flatnonzero(current.excess > 0.0)]
+        beyond = [int(t) for t in np.flatnonzero(current.cost > 0.0)]
         room = budget - len(current.s_wp)
         if room <= 0 or not beyond:
             break
