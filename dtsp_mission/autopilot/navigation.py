@@ -14,8 +14,9 @@ the vehicle's parameters (:meth:`Airframe.from_parameters`).
 
 from __future__ import annotations
 
+import copy as _copy
 import math
-from dataclasses import dataclass, field
+from dataclasses import dataclass, field, replace
 
 import numpy as np
 
@@ -169,6 +170,17 @@ class MissionFlight:
         self._demand = 0.0
         self._next_navigation_s = 0.0
         self._skip_instant_items()
+
+    def copy(self, items: list[LocalItem] | None = None) -> "MissionFlight":
+        """The flight as it is now, continuing on its own from here: stepping the copy leaves
+        this one as it is.  ``items`` (same seqs, other positions or parameters) are flown
+        from here on instead of the flight's own."""
+        other = _copy.copy(self)
+        other.items = self.items if items is None else items
+        other.state = replace(self.state)
+        other.reached = list(self.reached)
+        other._loiter = None if self._loiter is None else dict(self._loiter)
+        return other
 
     # -- mission sequencing ------------------------------------------------------------------
 
