@@ -143,6 +143,17 @@ def _continue(flight: MissionFlight, track: list, stop_after_seq: int,
     return saved
 
 
+def _measured(track: np.ndarray, reached: dict[int, float], last_seq: int, home: np.ndarray,
+              targets_m: np.ndarray) -> tuple[np.ndarray, float]:
+    """Per target, the closest approach of the track (rows time, x, y relative to ``home``)
+    after the take-off; and the track's length from the take-off's end to item ``last_seq``."""
+    flown = track[:, 1:] + home
+    after_takeoff = track[:, 0] >= reached.get(1, 0.0)
+    span = after_takeoff & (track[:, 0] <= reached.get(last_seq, np.inf))
+    return (closest_approach_m(flown[after_takeoff], targets_m),
+            float(np.hypot(*np.diff(flown[span], axis=0).T).sum()))
+
+
 def _nearest_in(track_xy: np.ndarray, point: np.ndarray) -> np.ndarray:
     """The point of the polyline ``track_xy`` nearest to ``point``."""
     a, d = track_xy[:-1], np.diff(track_xy, axis=0)
@@ -275,13 +286,8 @@ def _refine(aim: np.ndarray, target_of: list[int], items: list[LocalItem], seqs:
     marks = _continue(flight, track, len(items) - 2, seq_set)
     flights = 1
 
-    def misses(rows: list, reached: dict) -> np.ndarray:
-        array = np.array(rows)
-        after = array[:, 0] >= reached.get(1, 0.0)
-        return closest_approach_m(array[after, 1:] + home, targets_m)
-
     reached = dict(flight.reached)
-    miss = misses(track, reached)
+    miss, length = _measured(np.array(track), reached, len(items) - 2, home, targets_m)
     cost = _Trial.cost_of(miss, max_miss_m)
     aim = aim.copy()
     for k, t in enumerate(target_of):
@@ -339,14 +345,13 @@ def _refine(aim: np.ndarray, target_of: list[int], items: list[LocalItem], seqs:
         new_marks = _continue(again, rows_, len(items) - 2, {q for q in seq_set if q >= seqs[begin]})
         flights += 1
         new_reached = dict(again.reached)
-        new_miss = misses(rows_, new_reached)
+        new_miss, new_length = _measured(np.array(rows_), new_reached, len(items) - 2, home,
+                                         targets_m)
         new_cost = _Trial.cost_of(new_miss, max_miss_m)
         if new_cost.sum() < cost.sum():
-            aim, items, track, miss, cost, reached = candidate, changed, rows_, new_miss, new_cost, new_reached
+            aim, items, track, reached = candidate, changed, rows_, new_reached
+            miss, length, cost = new_miss, new_length, new_cost
             marks.update(new_marks)
-    array = np.array(track)
-    span = (array[:, 0] >= reached.get(1, 0.0)) & (array[:, 0] <= reached.get(len(items) - 2, np.inf))
-    length = float(np.hypot(*np.diff(array[span, 1:], axis=0).T).sum())
     return aim, miss, length, flights
 
 
@@ -356,14 +361,16 @@ def design_waypoints(path: FlightPath, targets_m: np.ndarray, altitudes_m: np.nd
                      target_acceptance_m: float = 5.0, rounds: int | None = None,
                      progress: Callable[[int, int], None] | None = None) -> GuidanceDesign:
     """The waypoints (``budget`` at most) that make the modelled autopilot pass every target
-    of ``path`` within ``max_miss_m``, as far as ``rounds`` predicted flights allow.
+    of ``path`` within ``max_miss_m``, as far as ``rounds`` predicted flights of the repair and
+    the local repair's passes allow.
 
     ``targets_m`` are the targets (input order, local frame), ``altitudes_m`` their altitudes
     above home; ``head_items`` are the (command, params) of the items flown between the take-off
     and the first waypoint (DO_CHANGE_SPEED).  The flight starts at the path's climb start
     (home) facing the start of the path.  The design returned is the best flown (least
     :attr:`_Trial.total`): a round that makes it worse is never kept.  ``progress(flights,
-    rounds)`` is called after each predicted flight.
+    rounds)`` is called after each predicted flight and after each local repair pass (those
+    fly beyond ``rounds``: one whole flight per change they keep or reject).
     """
     home = path.climb_start_m
     max_miss_m = max(max_miss_m - PREDICTION_MARGIN_M, 0.5 * max_miss_m)
@@ -401,10 +408,8 @@ def design_waypoints(path: FlightPath, targets_m: np.ndarray, altitudes_m: np.nd
         track, reached = _fly(items, airframe, heading, len(items) - 2)
         flown = track[:, 1:] + home
         after_takeoff = track[:, 0] >= reached.get(1, 0.0)
-        miss = closest_approach_m(flown[after_takeoff], targets_m)
+        miss, predicted = _measured(track, reached, len(items) - 2, home, targets_m)
         start_s = reached.get(1, 0.0)
-        span = after_takeoff & (track[:, 0] <= reached.get(len(items) - 2, np.inf))
-        predicted = float(np.hypot(*np.diff(flown[span], axis=0).T).sum())
         design = GuidanceDesign(np.asarray(s_wp), aim, np.asarray(target_of), miss, predicted,
                                 float(path.target_s_m.max()), flights)
         corrections = {}
