@@ -24,7 +24,8 @@ checked against recorded ArduPlane flights) and repairing what it misses:
    are spent;
 6. the local repair: each target still beyond, in visit order, is flown again from a checkpoint
    of the flight ``LOCAL_BACK`` waypoints before it to ``LOCAL_AHEAD`` after it (a few seconds
-   of flight instead of the whole mission), its own waypoint and the ``LOCAL_MOVE`` before it
+   of flight instead of the whole mission; none of the waypoints moved is at or before the
+   checkpoint's), its own waypoint and the ``LOCAL_MOVE`` before it
    moved by a pattern search (steps along east and north, halved when none helps); the change
    is kept only if the whole mission, flown again from the checkpoint, costs less.  Up to
    ``REFINE_PASSES`` passes; the design returned is the last one flown.
@@ -258,27 +259,30 @@ def _with_shaping(trial: _Trial, targets: list[int], lookback_m: float,
 #: The local repair: a target still beyond is re-flown from ``LOCAL_BACK`` waypoints before it
 #: to ``LOCAL_AHEAD`` after it, moving the waypoints ``LOCAL_MOVE`` before it and its own, in at
 #: most ``LOCAL_TRIALS`` short flights; a change is kept only if the whole mission flown again
-#: is better.
-LOCAL_BACK = 2
+#: is better.  The flight resumes one waypoint before the first one moved: a waypoint's
+#: position already decides when the one before it is reached (its turn angle scales the
+#: acceptance radius) and when a loiter before it is left.
+LOCAL_BACK = 3
+LOCAL_AHEAD = 3
+LOCAL_MOVE = 2
+LOCAL_TRIALS = 100
+LOCAL_MIN_STEP_M = 0.25
 #: Passes of the local repair over the targets still beyond (it stops early when one gains
 #: nothing).
 REFINE_PASSES = 3
 #: The design holds the targets this much closer than asked: its predictions (0.05 s steps)
 #: differ from the verifying flight's (0.02 s) by up to about half a metre.
 PREDICTION_MARGIN_M = 0.5
-LOCAL_AHEAD = 3
-LOCAL_MOVE = 2
-LOCAL_TRIALS = 100
-LOCAL_MIN_STEP_M = 0.25
 
 
 def _refine(aim: np.ndarray, target_of: list[int], items: list[LocalItem], seqs: list[int],
             home: np.ndarray, targets_m: np.ndarray, max_miss_m: float, airframe: Airframe,
             heading: float) -> tuple[np.ndarray, np.ndarray, float, int]:
-    """(aims, per-target miss, predicted length, full flights) after the local repair of every
-    target still beyond ``max_miss_m``, in visit order, each from the design as repaired so
-    far.  A change is kept only if the whole mission flown with it costs less
-    (:meth:`_Trial.cost_of`); the misses and length are those of the last mission flown."""
+    """(aims, per-target miss, predicted length, full flights) after up to
+    :data:`REFINE_PASSES` passes of the local repair over the targets still beyond
+    ``max_miss_m``, in visit order, each from the design as repaired so far.  A change is kept
+    only if the whole mission flown with it costs less (:meth:`_Trial.cost_of`); the misses
+    and length are those of the last mission kept."""
     items = list(items)
     seq_set = set(seqs)
     flight = MissionFlight(items, airframe, heading, 1)
@@ -290,68 +294,73 @@ def _refine(aim: np.ndarray, target_of: list[int], items: list[LocalItem], seqs:
     miss, length = _measured(np.array(track), reached, len(items) - 2, home, targets_m)
     cost = _Trial.cost_of(miss, max_miss_m)
     aim = aim.copy()
-    for k, t in enumerate(target_of):
-        if t < 0 or cost[t] <= 0.0:
-            continue
-        begin, end = max(k - LOCAL_BACK, 0), min(k + LOCAL_AHEAD, len(seqs) - 1)
-        start, rows = marks[seqs[begin]]
-        window = [target_of[j] for j in range(begin, end + 1) if target_of[j] >= 0]
-        before = np.array(track[:rows])
-        before = before[before[:, 0] >= reached.get(1, 0.0)]
-        fixed = (closest_approach_m(before[:, 1:] + home, targets_m[window]) if len(before) > 1
-                 else np.full(len(window), np.inf))
-        movable = [j for j in range(max(k - LOCAL_MOVE, begin), k + 1)]
+    for _ in range(REFINE_PASSES):
+        before_pass = cost.sum()
+        for k, t in enumerate(target_of):
+            if t < 0 or cost[t] <= 0.0:
+                continue
+            begin, end = max(k - LOCAL_BACK, 0), min(k + LOCAL_AHEAD, len(seqs) - 1)
+            start, rows = marks[seqs[begin]]
+            window = [target_of[j] for j in range(begin, end + 1) if target_of[j] >= 0]
+            before = np.array(track[:rows])
+            before = before[before[:, 0] >= reached.get(1, 0.0)]
+            fixed = (closest_approach_m(before[:, 1:] + home, targets_m[window]) if len(before) > 1
+                     else np.full(len(window), np.inf))
+            movable = list(range(max(k - LOCAL_MOVE, begin + 1 if begin > 0 else 0), k + 1))
 
-        def with_aims(points: np.ndarray) -> list[LocalItem]:
-            changed = list(items)
-            for j in movable:
-                x, y = points[j] - home
-                changed[seqs[j]] = replace(items[seqs[j]], x_m=float(x), y_m=float(y))
-            return changed
+            def with_aims(points: np.ndarray) -> list[LocalItem]:
+                changed = list(items)
+                for j in movable:
+                    x, y = points[j] - home
+                    changed[seqs[j]] = replace(items[seqs[j]], x_m=float(x), y_m=float(y))
+                return changed
 
-        def local_cost(points: np.ndarray) -> float:
-            trial = start.copy(with_aims(points))
-            rows_ = [track[rows - 1]]
-            _continue(trial, rows_, seqs[end])
-            flown = np.array(rows_)[:, 1:] + home
-            m = np.minimum(fixed, closest_approach_m(flown, targets_m[window]))
-            return float(_Trial.cost_of(m, max_miss_m).sum())
+            def local_cost(points: np.ndarray) -> float:
+                trial = start.copy(with_aims(points))
+                rows_ = [track[rows - 1]]
+                _continue(trial, rows_, seqs[end])
+                flown = np.array(rows_)[:, 1:] + home
+                m = np.minimum(fixed, closest_approach_m(flown, targets_m[window]))
+                return float(_Trial.cost_of(m, max_miss_m).sum())
 
-        current = local_cost(aim)
-        trials = 1
-        step_m = max(min(miss[t] - max_miss_m, 10.0), 1.0)
-        candidate = aim.copy()
-        while trials < LOCAL_TRIALS and step_m >= LOCAL_MIN_STEP_M and current > 0.0:
-            best_move, best_cost = None, current
-            for j in movable:
-                for direction in ((1, 0), (-1, 0), (0, 1), (0, -1)):
-                    if trials >= LOCAL_TRIALS:
-                        break
-                    moved = candidate.copy()
-                    moved[j] += step_m * np.asarray(direction)
-                    c = local_cost(moved)
-                    trials += 1
-                    if c < best_cost:
-                        best_move, best_cost = moved, c
-            if best_move is None:
-                step_m *= 0.5
-            else:
-                candidate, current = best_move, best_cost
-        if not np.any(candidate != aim):
-            continue
-        changed = with_aims(candidate)
-        again = start.copy(changed)
-        rows_ = list(track[:rows])
-        new_marks = _continue(again, rows_, len(items) - 2, {q for q in seq_set if q >= seqs[begin]})
-        flights += 1
-        new_reached = dict(again.reached)
-        new_miss, new_length = _measured(np.array(rows_), new_reached, len(items) - 2, home,
-                                         targets_m)
-        new_cost = _Trial.cost_of(new_miss, max_miss_m)
-        if new_cost.sum() < cost.sum():
-            aim, items, track, reached = candidate, changed, rows_, new_reached
-            miss, length, cost = new_miss, new_length, new_cost
-            marks.update(new_marks)
+            current = local_cost(aim)
+            trials = 1
+            step_m = max(min(miss[t] - max_miss_m, 10.0), 1.0)
+            candidate = aim.copy()
+            while trials < LOCAL_TRIALS and step_m >= LOCAL_MIN_STEP_M and current > 0.0:
+                best_move, best_cost = None, current
+                for j in movable:
+                    for direction in ((1, 0), (-1, 0), (0, 1), (0, -1)):
+                        if trials >= LOCAL_TRIALS:
+                            break
+                        moved = candidate.copy()
+                        moved[j] += step_m * np.asarray(direction)
+                        c = local_cost(moved)
+                        trials += 1
+                        if c < best_cost:
+                            best_move, best_cost = moved, c
+                if best_move is None:
+                    step_m *= 0.5
+                else:
+                    candidate, current = best_move, best_cost
+            if not np.any(candidate != aim):
+                continue
+            changed = with_aims(candidate)
+            again = start.copy(changed)
+            rows_ = list(track[:rows])
+            new_marks = _continue(again, rows_, len(items) - 2,
+                                  {q for q in seq_set if q >= seqs[begin]})
+            flights += 1
+            new_reached = dict(again.reached)
+            new_miss, new_length = _measured(np.array(rows_), new_reached, len(items) - 2, home,
+                                             targets_m)
+            new_cost = _Trial.cost_of(new_miss, max_miss_m)
+            if new_cost.sum() < cost.sum():
+                aim, items, track, reached = candidate, changed, rows_, new_reached
+                miss, length, cost = new_miss, new_length, new_cost
+                marks.update(new_marks)
+        if cost.sum() >= before_pass or not (cost > 0.0).any():
+            break
     return aim, miss, length, flights
 
 
@@ -462,24 +471,16 @@ def design_waypoints(path: FlightPath, targets_m: np.ndarray, altitudes_m: np.nd
         current = _with_shaping(current, beyond[:room], lookback_m, loiter_ends, fly)
         best = current if current.total < best.total else best
         step, idle = 1.0, 0
-    if best.total > 0.0:
+    if best.total > 0.0 and REFINE_PASSES > 0:
         design = best.design
         items, seqs = _local_items(takeoff, takeoff_alt, head_items, design.aim_m - home,
                                    path.altitude_m(design.s_m), best.target_of,
                                    target_acceptance_m, loiters)
-        aim, miss, length = design.aim_m, design.predicted_miss_m, design.predicted_length_m
-        for _ in range(REFINE_PASSES):
-            before = _Trial.cost_of(miss, max_miss_m).sum()
-            aim, miss, length, flown = _refine(aim, best.target_of, items, seqs, home, targets_m,
-                                               max_miss_m, airframe, heading)
-            flights += flown
-            if progress is not None:
-                progress(min(flights, rounds), rounds)
-            items, seqs = _local_items(takeoff, takeoff_alt, head_items, aim - home,
-                                       path.altitude_m(design.s_m), best.target_of,
-                                       target_acceptance_m, loiters)
-            if _Trial.cost_of(miss, max_miss_m).sum() >= before or not (miss > max_miss_m).any():
-                break
+        aim, miss, length, flown = _refine(design.aim_m, best.target_of, items, seqs, home,
+                                           targets_m, max_miss_m, airframe, heading)
+        flights += flown
+        if progress is not None:
+            progress(min(flights, rounds), rounds)
         return GuidanceDesign(design.s_m, aim, design.target_of, miss, length,
                               design.planned_length_m, flights)
     return best.design

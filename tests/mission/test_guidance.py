@@ -174,4 +174,4 @@ def test_the_local_repair_holds_more_and_reports_what_the_mission_flies(monkeypa
     after = flight.track[:, 0] >= flight.reached[1]
     xy = flight.frame.to_local(targets.latitudes_deg, targets.longitudes_deg)
     flown = closest_approach_m(flight.track[after, 1:3], xy)
-    assert np.abs(flown - held).max() < 0.3
+    assert np.abs(flown - held).max() < 0.1     # the same flight, but for the rounding to 1e-7 deg
