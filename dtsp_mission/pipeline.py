@@ -22,7 +22,7 @@ from .dubins.path import check_radius
 from .errors import InputError, MissionTooLarge
 from .frame import LocalFrame, mission_centre
 from .mission import Mission, MissionSettings, build_mission
-from .mission.build import GUIDANCE_MARGINS, targets_beyond, with_turn_margin
+from .mission.build import GUIDANCE_MARGINS, length_excess, targets_beyond, with_turn_margin
 from .mission.sorties import Sortie, split_into_sorties
 from .planning import TilingUnavailable, get_planner
 from .planning.lower_bounds import LowerBound, lower_bound
@@ -209,7 +209,9 @@ def _design_mission(request: PlanRequest, result: PlanResult,
                 f"planned with a turn radius of {widened.rho_m:g} m instead of "
                 f"{mission.rho_m:g} m so that the autopilot's guidance can hold the turns: "
                 f"{targets_beyond(mission, settings.max_miss_m)} -> "
-                f"{targets_beyond(widened, settings.max_miss_m)} targets predicted beyond --max-miss")
+                f"{targets_beyond(widened, settings.max_miss_m)} targets predicted beyond "
+                f"--max-miss, the predicted flight {100 * length_excess(mission):+.1f} % -> "
+                f"{100 * length_excess(widened):+.1f} % of the planned one")
             mission = widened
     result.mission = mission
     flight_s = mission.summary.get("flight_time_s", 0.0)

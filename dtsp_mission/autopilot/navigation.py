@@ -38,6 +38,9 @@ ROLL_DAMPING = 0.6
 #: bank (regression of the recorded course rate on the recorded roll: 0.73-0.80 over the
 #: cases; 0.73 agrees best with the tracks, docs/arduplane-agreement.md).
 SITL_TURN_EFFICIENCY = 0.73
+#: The time step the model's agreement with recorded ArduPlane flights was measured at
+#: (docs/arduplane-agreement.md): the flight that predicts, verifies and simulates a mission.
+MODEL_STEP_S = 0.02
 #: LOITER_TURNS with the tangent exit leaves when the course is this close to the next waypoint.
 LOITER_EXIT_HEADING_RAD = math.radians(10.0)
 

@@ -23,7 +23,7 @@ from pathlib import Path
 import numpy as np
 
 from ..autopilot import Command
-from ..autopilot.navigation import Airframe, MissionFlight, closest_approach_m
+from ..autopilot.navigation import MODEL_STEP_S, Airframe, MissionFlight, closest_approach_m
 from ..autopilot.parameters import read_parameters
 from ..export import read_mission
 from ..frame import LocalFrame
@@ -87,7 +87,7 @@ def _length(xy: np.ndarray) -> float:
     return float(np.hypot(*np.diff(xy, axis=0).T).sum()) if len(xy) > 1 else 0.0
 
 
-def fly_recorded_mission(folder: Path, airframe: Airframe | None = None, dt_s: float = 0.02,
+def fly_recorded_mission(folder: Path, airframe: Airframe | None = None, dt_s: float = MODEL_STEP_S,
                          ) -> tuple[MissionFlight, np.ndarray, LocalFrame]:
     """The model's flight of the case's mission (as ArduPilot stored it) with the case's
     parameters, on until :data:`RECORDED_AFTER_S` after the last item as recorded: the

@@ -22,20 +22,25 @@ checked against recorded ArduPlane flights) and repairing what it misses:
    within ``LOOKBACK_L1``) and the corrections go on from there;
 5. repeat until every target holds or the predicted flights (``ROUNDS``) or the item budget
    are spent;
-6. the local repair: each target still beyond, in visit order, is flown again from a checkpoint
-   of the flight ``LOCAL_BACK`` waypoints before it to ``LOCAL_AHEAD`` after it (a few seconds
-   of flight instead of the whole mission; none of the waypoints moved is at or before the
-   checkpoint's), its own waypoint and the ``LOCAL_MOVE`` before it
-   moved by a pattern search (steps along east and north, halved when none helps); the change
-   is kept only if the whole mission, flown again from the checkpoint, costs less.  Up to
-   ``REFINE_PASSES`` passes; the design returned is the last one flown.
+6. the verifying flight: the design flown afresh at the model's own step (``VERIFY_STEP_S``,
+   the step its agreement with ArduPlane was measured at, and the one ``fly`` and
+   ``predict_flight`` use), every waypoint where the vehicle stores it (rounded to 1e-7
+   degree: a switch one step earlier or later moves the track by decimetres);
+7. the local repair, at that step: each target it finds beyond, in visit order, is flown
+   again from a checkpoint of the flight ``LOCAL_BACK`` waypoints before it to
+   ``LOCAL_AHEAD`` after it (a few seconds of flight instead of the whole mission; none of the
+   waypoints moved is at or before the checkpoint's), its own waypoint and the
+   ``LOCAL_MOVE`` before it moved by a pattern search (steps along east and north, halved when
+   none helps); the change is kept only if the mission flown on from the checkpoint costs
+   less.  Up to ``REFINE_PASSES`` passes, each ending with the whole mission flown afresh;
+   the design returned is the best of those fresh flights.
 
-The design holds the targets within ``max_miss_m - PREDICTION_MARGIN_M`` in its own
-prediction, so that the finer flight that verifies it (0.02 s steps) finds them within
-``max_miss_m``.
+The rounds 2-5 (at the coarser ``PREDICTION_STEP_S``) hold the targets within ``max_miss_m -
+PREDICTION_MARGIN_M``; the verifying flight and the local repair within ``max_miss_m -
+VERIFY_MARGIN_M``.
 
-Guarantee: the returned design says, per target, the predicted miss; nothing is claimed that
-the model did not fly.
+Guarantee: the returned design says, per target, the miss of the mission as stored, flown
+by the model at its own step from the start; nothing is claimed that the model did not fly.
 """
 
 from __future__ import annotations
@@ -47,7 +52,8 @@ from typing import Callable
 import numpy as np
 
 from ..autopilot.commands import Command
-from ..autopilot.navigation import Airframe, LocalItem, MissionFlight, closest_approach_m
+from ..autopilot.navigation import (MODEL_STEP_S, Airframe, LocalItem, MissionFlight,
+                                    closest_approach_m)
 from .actions import loiter_turns_params
 from .model import FlightPath
 
@@ -119,14 +125,14 @@ def _fly(items: list[LocalItem], airframe: Airframe, heading_rad: float,
     """Track rows (time, x, y) and reach times, until item ``stop_after_seq`` is reached."""
     flight = MissionFlight(items, airframe, heading_rad, 1)
     track = [(0.0, 0.0, 0.0)]
-    _continue(flight, track, stop_after_seq)
+    _continue(flight, track, stop_after_seq, PREDICTION_STEP_S)
     return np.array(track), dict(flight.reached)
 
 
-def _continue(flight: MissionFlight, track: list, stop_after_seq: int,
+def _continue(flight: MissionFlight, track: list, stop_after_seq: int, step_s: float,
               marks: set[int] | None = None) -> dict[int, tuple[MissionFlight, int]]:
-    """Steps ``flight`` until item ``stop_after_seq`` is reached, its rows (time, x, y) added to
-    ``track``; returns, for each seq of ``marks``, a copy of the flight as that item became
+    """Steps ``flight`` by ``step_s`` until item ``stop_after_seq`` is reached, its rows (time,
+    x, y) added to ``track``; returns, for each seq of ``marks``, a copy of the flight as that item became
     the current one and the number of track rows then."""
     saved: dict[int, tuple[MissionFlight, int]] = {}
     seen = None
@@ -136,7 +142,7 @@ def _continue(flight: MissionFlight, track: list, stop_after_seq: int,
             seen = flight.current.seq
             if seen in marks:
                 saved[seen] = (flight.copy(), len(track))
-        flight.step(PREDICTION_STEP_S)
+        flight.step(step_s)
         state = flight.state
         track.append((state.time_s, state.x_m, state.y_m))
         if flight.reached and flight.reached[-1][0] >= stop_after_seq:
@@ -270,32 +276,47 @@ LOCAL_MIN_STEP_M = 0.25
 #: Passes of the local repair over the targets still beyond (it stops early when one gains
 #: nothing).
 REFINE_PASSES = 3
-#: The design holds the targets this much closer than asked: its predictions (0.05 s steps)
-#: differ from the verifying flight's (0.02 s) by up to about half a metre.
+#: The repair holds the targets this much closer than asked: its predictions (0.05 s steps)
+#: differ from the verifying flight's by up to 1.5 m (bundled site), mostly under half a metre.
 PREDICTION_MARGIN_M = 0.5
+#: The local repair flies at the step of the verifying flight (the one the model's agreement
+#: with ArduPlane was measured at, which `fly` and `predict_flight` fly too), and holds the
+#: targets this much inside ``max_miss_m``.
+VERIFY_STEP_S = MODEL_STEP_S
+VERIFY_MARGIN_M = 0.05
 
 
 def _refine(aim: np.ndarray, target_of: list[int], items: list[LocalItem], seqs: list[int],
             home: np.ndarray, targets_m: np.ndarray, max_miss_m: float, airframe: Airframe,
-            heading: float) -> tuple[np.ndarray, np.ndarray, float, int]:
-    """(aims, per-target miss, predicted length, full flights) after up to
+            heading: float, stored: Callable[[np.ndarray], np.ndarray]
+            ) -> tuple[np.ndarray, np.ndarray, float, int]:
+    """(aims, per-target miss, predicted length, whole flights) after up to
     :data:`REFINE_PASSES` passes of the local repair over the targets still beyond
     ``max_miss_m``, in visit order, each from the design as repaired so far.  A change is kept
-    only if the whole mission flown with it costs less (:meth:`_Trial.cost_of`); the misses
-    and length are those of the last mission kept."""
+    only if the mission flown on with it from its checkpoint costs less
+    (:meth:`_Trial.cost_of`); a moved waypoint is placed ``stored``.  Each pass ends with the whole mission flown afresh from the
+    start: the misses and length returned are those of the best such flight (a resumed flight
+    can differ from a fresh one by a few decimetres), so they are what the mission flies."""
     items = list(items)
     seq_set = set(seqs)
-    flight = MissionFlight(items, airframe, heading, 1)
-    track: list = [(0.0, 0.0, 0.0)]
-    marks = _continue(flight, track, len(items) - 2, seq_set)
-    flights = 1
+    last = len(items) - 2
 
-    reached = dict(flight.reached)
-    miss, length = _measured(np.array(track), reached, len(items) - 2, home, targets_m)
-    cost = _Trial.cost_of(miss, max_miss_m)
+    def afresh(items: list[LocalItem]):
+        flight = MissionFlight(items, airframe, heading, 1)
+        track: list = [(0.0, 0.0, 0.0)]
+        marks = _continue(flight, track, last, VERIFY_STEP_S, seq_set)
+        reached = dict(flight.reached)
+        miss, length = _measured(np.array(track), reached, last, home, targets_m)
+        return marks, track, reached, miss, length, _Trial.cost_of(miss, max_miss_m)
+
+    marks, track, reached, miss, length, cost = afresh(items)
+    flights = 1
     aim = aim.copy()
+    best = (aim, miss, length, cost.sum())
     for _ in range(REFINE_PASSES):
         before_pass = cost.sum()
+        if before_pass <= 0.0:
+            break
         for k, t in enumerate(target_of):
             if t < 0 or cost[t] <= 0.0:
                 continue
@@ -318,7 +339,7 @@ def _refine(aim: np.ndarray, target_of: list[int], items: list[LocalItem], seqs:
             def local_cost(points: np.ndarray) -> float:
                 trial = start.copy(with_aims(points))
                 rows_ = [track[rows - 1]]
-                _continue(trial, rows_, seqs[end])
+                _continue(trial, rows_, seqs[end], VERIFY_STEP_S)
                 flown = np.array(rows_)[:, 1:] + home
                 m = np.minimum(fixed, closest_approach_m(flown, targets_m[window]))
                 return float(_Trial.cost_of(m, max_miss_m).sum())
@@ -334,7 +355,7 @@ def _refine(aim: np.ndarray, target_of: list[int], items: list[LocalItem], seqs:
                         if trials >= LOCAL_TRIALS:
                             break
                         moved = candidate.copy()
-                        moved[j] += step_m * np.asarray(direction)
+                        moved[j] = stored((moved[j] + step_m * np.asarray(direction))[None])[0]
                         c = local_cost(moved)
                         trials += 1
                         if c < best_cost:
@@ -348,27 +369,31 @@ def _refine(aim: np.ndarray, target_of: list[int], items: list[LocalItem], seqs:
             changed = with_aims(candidate)
             again = start.copy(changed)
             rows_ = list(track[:rows])
-            new_marks = _continue(again, rows_, len(items) - 2,
+            new_marks = _continue(again, rows_, last, VERIFY_STEP_S,
                                   {q for q in seq_set if q >= seqs[begin]})
             flights += 1
             new_reached = dict(again.reached)
-            new_miss, new_length = _measured(np.array(rows_), new_reached, len(items) - 2, home,
-                                             targets_m)
+            new_miss, new_length = _measured(np.array(rows_), new_reached, last, home, targets_m)
             new_cost = _Trial.cost_of(new_miss, max_miss_m)
             if new_cost.sum() < cost.sum():
                 aim, items, track, reached = candidate, changed, rows_, new_reached
                 miss, length, cost = new_miss, new_length, new_cost
                 marks.update(new_marks)
-        if cost.sum() >= before_pass or not (cost > 0.0).any():
+        if cost.sum() >= before_pass:
             break
-    return aim, miss, length, flights
+        marks, track, reached, miss, length, cost = afresh(items)
+        flights += 1
+        if cost.sum() < best[3]:
+            best = (aim, miss, length, cost.sum())
+    return best[0], best[1], best[2], flights
 
 
 def design_waypoints(path: FlightPath, targets_m: np.ndarray, altitudes_m: np.ndarray,
                      airframe: Airframe, max_miss_m: float, budget: int,
                      head_items: list[tuple[int, tuple[float, float, float, float]]] = (),
                      target_acceptance_m: float = 5.0, rounds: int | None = None,
-                     progress: Callable[[int, int], None] | None = None) -> GuidanceDesign:
+                     progress: Callable[[int, int], None] | None = None,
+                     as_stored: Callable[[np.ndarray], np.ndarray] | None = None) -> GuidanceDesign:
     """The waypoints (``budget`` at most) that make the modelled autopilot pass every target
     of ``path`` within ``max_miss_m``, as far as ``rounds`` predicted flights of the repair and
     the local repair's passes allow.
@@ -380,9 +405,13 @@ def design_waypoints(path: FlightPath, targets_m: np.ndarray, altitudes_m: np.nd
     :attr:`_Trial.total`): a round that makes it worse is never kept.  ``progress(flights,
     rounds)`` is called after each predicted flight and after each local repair pass (those
     fly beyond ``rounds``: one whole flight per change they keep or reject).
+    ``as_stored`` maps positions (``(k, 2)``, local frame) to where the
+    vehicle stores them (the mission's rounding to 1e-7 degree): the design flies those, since
+    the switch of a waypoint one step earlier or later moves the track by decimetres.
     """
     home = path.climb_start_m
-    max_miss_m = max(max_miss_m - PREDICTION_MARGIN_M, 0.5 * max_miss_m)
+    stored = as_stored if as_stored is not None else (lambda points: points)
+    repair_miss_m = max(max_miss_m - PREDICTION_MARGIN_M, 0.5 * max_miss_m)
     order = np.argsort(path.target_s_m, kind="stable")
     s_wp = list(path.target_s_m[order])
     target_of = list(order)
@@ -409,8 +438,8 @@ def design_waypoints(path: FlightPath, targets_m: np.ndarray, altitudes_m: np.nd
         if progress is not None:
             progress(flights, rounds)
         exact = path.chain.pose_at(np.asarray(s_wp))[:, :2]
-        aim = np.array([targets_m[t] + offsets[t] if t >= 0 else exact[k]
-                        for k, t in enumerate(target_of)])
+        aim = stored(np.array([targets_m[t] + offsets[t] if t >= 0 else exact[k]
+                               for k, t in enumerate(target_of)]))
         items, seqs = _local_items(takeoff, takeoff_alt, head_items, aim - home,
                                    path.altitude_m(np.asarray(s_wp)), target_of,
                                    target_acceptance_m, loiters)
@@ -423,7 +452,7 @@ def design_waypoints(path: FlightPath, targets_m: np.ndarray, altitudes_m: np.nd
                                 float(path.target_s_m.max()), flights)
         corrections = {}
         for k, t in enumerate(target_of):       # the track near each target's own leg
-            if t < 0 or miss[t] <= CORRECT_ABOVE * max_miss_m:
+            if t < 0 or miss[t] <= CORRECT_ABOVE * repair_miss_m:
                 continue
             begin = reached.get(seqs[k] - 1, start_s)
             end = reached.get(seqs[k] + 1, track[-1, 0])
@@ -432,7 +461,7 @@ def design_waypoints(path: FlightPath, targets_m: np.ndarray, altitudes_m: np.nd
                 window = after_takeoff
             corrections[t] = targets_m[t] - _nearest_in(flown[window], targets_m[t])
         return _Trial(list(s_wp), list(target_of), dict(offsets), design,
-                      _Trial.cost_of(miss, max_miss_m), corrections)
+                      _Trial.cost_of(miss, repair_miss_m), corrections)
 
     def local(trial: _Trial, t: int) -> float:
         """Cost at target t and the next targets it affects (visit order)."""
@@ -471,16 +500,16 @@ def design_waypoints(path: FlightPath, targets_m: np.ndarray, altitudes_m: np.nd
         current = _with_shaping(current, beyond[:room], lookback_m, loiter_ends, fly)
         best = current if current.total < best.total else best
         step, idle = 1.0, 0
-    if best.total > 0.0 and REFINE_PASSES > 0:
-        design = best.design
-        items, seqs = _local_items(takeoff, takeoff_alt, head_items, design.aim_m - home,
-                                   path.altitude_m(design.s_m), best.target_of,
-                                   target_acceptance_m, loiters)
-        aim, miss, length, flown = _refine(design.aim_m, best.target_of, items, seqs, home,
-                                           targets_m, max_miss_m, airframe, heading)
-        flights += flown
-        if progress is not None:
-            progress(min(flights, rounds), rounds)
-        return GuidanceDesign(design.s_m, aim, design.target_of, miss, length,
-                              design.planned_length_m, flights)
-    return best.design
+    # The design as the verifying flight sees it, and the local repair of what it misses.
+    design = best.design
+    items, seqs = _local_items(takeoff, takeoff_alt, head_items, design.aim_m - home,
+                               path.altitude_m(design.s_m), best.target_of,
+                               target_acceptance_m, loiters)
+    verify_miss_m = max(max_miss_m - VERIFY_MARGIN_M, 0.5 * max_miss_m)
+    aim, miss, length, flown = _refine(design.aim_m, best.target_of, items, seqs, home,
+                                       targets_m, verify_miss_m, airframe, heading, stored)
+    flights += flown
+    if progress is not None:
+        progress(min(flights, rounds), rounds)
+    return GuidanceDesign(design.s_m, aim, design.target_of, miss, length,
+                          design.planned_length_m, flights)

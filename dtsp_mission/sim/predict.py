@@ -13,7 +13,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from ..autopilot import Command, stored_item
-from ..autopilot.navigation import Airframe, LocalItem, MissionFlight, local_items
+from ..autopilot.navigation import MODEL_STEP_S, Airframe, LocalItem, MissionFlight, local_items
 from ..frame import LocalFrame
 from ..mission import VehicleMission
 from ..upload.wire import first_mission_seq, to_wire
@@ -32,7 +32,7 @@ class PredictedFlight:
     flight: MissionFlight
 
 
-def predict_flight(mission: VehicleMission, airframe: Airframe, dt_s: float = 0.02,
+def predict_flight(mission: VehicleMission, airframe: Airframe, dt_s: float = MODEL_STEP_S,
                    after_last_s: float = 0.0, limit_s: float = 36000.0) -> PredictedFlight:
     """Fly ``mission`` until its last waypoint or loiter is reached, then ``after_last_s`` more
     (in RTL, as ArduPlane goes on after a mission without one)."""

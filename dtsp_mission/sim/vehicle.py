@@ -27,7 +27,7 @@ from dataclasses import dataclass, field
 import numpy as np
 from pymavlink.dialects.v20 import common as mavlink2
 
-from ..autopilot.navigation import Airframe, LocalItem, MissionFlight, local_items
+from ..autopilot.navigation import MODEL_STEP_S, Airframe, LocalItem, MissionFlight, local_items
 from ..autopilot.parameters import ARDUPLANE_DEFAULTS, NAMES, VehicleParameters, parameter_name
 from ..autopilot.storage import MissionStore, stored_item
 from ..frame import LocalFrame
@@ -62,7 +62,7 @@ class VehicleSettings:
     autopilot: Autopilot = Autopilot.ARDUPILOTMEGA
     airframe: Airframe = Airframe()
     speedup: float = 50.0             # simulated seconds per wall second; 0: as fast as possible
-    step_s: float = 0.05
+    step_s: float = MODEL_STEP_S
     telemetry_hz: float = 10.0        # position messages per simulated second
     max_items: int | None = None      # mission slots (home included on ArduPilot); None: a
                                       # stock vehicle's (ArduPlane 655, PX4 500)

@@ -122,8 +122,8 @@ def test_the_repair_keeps_only_what_the_model_flew_better(monkeypatch):
     monkeypatch.setattr(guidance, "REFINE_PASSES", 0)
     first = build_mission(tour, frame, targets, settings)
     assert excess(repaired)[0] < excess(first)[0] and excess(repaired)[1] < excess(first)[1]
-    assert 1 < repaired.summary["design_rounds"]
-    assert first.summary["design_rounds"] == 1
+    assert 2 < repaired.summary["design_rounds"]
+    assert first.summary["design_rounds"] == 2       # one predicted flight, then the verifying one
 
 
 def test_a_flight_copied_midway_goes_on_exactly_as_the_original():
@@ -156,8 +156,9 @@ def test_a_flight_copied_midway_goes_on_exactly_as_the_original():
 
 
 def test_the_local_repair_holds_more_and_reports_what_the_mission_flies(monkeypatch):
-    """The local repair (short flights from checkpoints) ends with no more targets beyond than
-    the global repair, and the misses it reports are those of the whole mission flown again."""
+    """The local repair (short flights from checkpoints) ends with fewer targets beyond than
+    the global repair, and the misses it reports are those of the written mission flown again
+    from the start at the model's step."""
     import dtsp_mission.mission.guidance as guidance
     tour, frame, targets = _fence(80.0)
     settings = MissionSettings(design="guidance", airspeed_m_s=22.0, altitude_m=120.0)
@@ -170,8 +171,26 @@ def test_the_local_repair_holds_more_and_reports_what_the_mission_flies(monkeypa
     assert (before > 5.0).sum() > 0
     assert (held > 5.0).sum() < (before > 5.0).sum()
     flight = predict_flight(repaired.for_vehicle(), Airframe.from_parameters(airspeed_m_s=22.0),
-                            guidance.PREDICTION_STEP_S)
+                            guidance.VERIFY_STEP_S)
     after = flight.track[:, 0] >= flight.reached[1]
     xy = flight.frame.to_local(targets.latitudes_deg, targets.longitudes_deg)
     flown = closest_approach_m(flight.track[after, 1:3], xy)
-    assert np.abs(flown - held).max() < 0.1     # the same flight, but for the rounding to 1e-7 deg
+    assert np.abs(flown - held).max() < 0.01    # the same flight: the design flies the stored positions
+
+
+def test_a_flight_that_strays_from_its_plan_is_planned_again_with_wider_turns():
+    """At rho 80 m this site's predicted flight is more than 5 % longer than the planned one
+    (the autopilot swings wide of turns it cannot hold and loops back to the targets after
+    them); the turn margin plans it again wider, and the mission it keeps follows its plan
+    within FOLLOWS_PLAN_WITHIN and still holds every target."""
+    from dtsp_mission.mission.build import FOLLOWS_PLAN_WITHIN, length_excess, with_turn_margin
+    tour, frame, targets = sparse_site(40, seed=1, side=350.0 * np.sqrt(40))
+    settings = MissionSettings(altitude_m=120.0, airspeed_m_s=22.0, design="guidance")
+    mission = build_mission(tour, frame, targets, settings)
+    assert max(mission.summary["predicted_miss_m"]) <= 5.0
+    assert length_excess(mission) > FOLLOWS_PLAN_WITHIN
+    widened = with_turn_margin(mission, lambda rho: get_planner("auto").plan(
+        targets.in_frame(frame).positions_m, rho), targets, settings)
+    assert widened.rho_m > mission.rho_m
+    assert length_excess(widened) <= FOLLOWS_PLAN_WITHIN
+    assert max(widened.summary["predicted_miss_m"]) <= 5.0
