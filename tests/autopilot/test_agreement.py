@@ -49,3 +49,12 @@ def test_the_model_flies_like_the_recorded_arduplane(case):
     assert result.approach_max_m <= closest_max
     # the model flies the whole mission, about as far as the real aircraft did
     assert result.model_length_m == pytest.approx(result.real_length_m, rel=0.02)
+
+
+@pytest.mark.parametrize("case", sorted(p.name for p in DATA.iterdir() if (p / "params.parm").exists()))
+def test_every_recorded_parameter_set_is_the_one_missions_are_designed_for(case):
+    """The guidance design predicts with ArduPlane's defaults; every parameter set the real
+    ArduPlane flew with reads to exactly those (so a mission designed for the defaults is
+    designed for each of them, and `--vehicle-params` with any of them changes nothing)."""
+    from dtsp_mission.autopilot.parameters import ARDUPLANE_DEFAULTS, read_parameters
+    assert read_parameters(DATA / case / "params.parm").differing(ARDUPLANE_DEFAULTS) == []
