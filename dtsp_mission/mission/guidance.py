@@ -32,7 +32,7 @@ checked against recorded ArduPlane flights) and repairing what it misses:
    waypoints moved is at or before the checkpoint's), its own waypoint and the
    ``LOCAL_MOVE`` before it moved by a pattern search (steps along east and north, halved when
    none helps) and, if that leaves it beyond, from the best of ``LOCAL_STARTS`` random
-   placements of them within ``LOCAL_SPREAD_M``; the change is kept only if the mission flown
+   placements of them within ``LOCAL_SPREAD_M`` (none by default); the change is kept only if the mission flown
    on from the checkpoint costs less.  Up to ``REFINE_PASSES`` passes, each ending with the whole mission flown afresh;
    the design returned is the best of those fresh flights.
 
@@ -274,14 +274,15 @@ LOCAL_AHEAD = 3
 LOCAL_MOVE = 2
 LOCAL_TRIALS = 100
 LOCAL_MIN_STEP_M = 0.25
-#: A target the pattern search leaves beyond gets up to this many other starts (seeded by its
-#: place in the mission; the first that holds it ends them), every movable waypoint anywhere
-#: within ``LOCAL_SPREAD_M`` east and north of where it was; the pattern search goes on from
-#: the best of them if it is better than where it started.  Measured: the 400-target
-#: clustered site at 1.6 rho 4 -> 1 targets beyond (worst 22.6 -> 17.4 m) with 300 starts; the
-#: bundled site held at 1.3 rho instead of 1.6 (27.4 instead of 32.4 km, 1.12 instead of 1.24
-#: items per target) with 300 or 100 starts, its design 239 s with 100, 319 s with 300.
-LOCAL_STARTS = 100
+#: A target the pattern search leaves beyond can get up to this many other starts (seeded by
+#: its place in the mission; the first that holds it ends them), every movable waypoint
+#: anywhere within ``LOCAL_SPREAD_M`` east and north of where it was; the pattern search goes
+#: on from the best of them if it is better than where it started.  Off by default: measured
+#: (docs/mission-items.md), 100 starts take the 400-target clustered site from 4 to 2 targets
+#: beyond (worst 22.6 -> 17.4 m) and hold the bundled site at 1.3 rho instead of 1.6 (27.4
+#: instead of 32.4 km, 1.12 instead of 1.24 items per target), but they double the design
+#: time (bundled site 239 s) and put the test suite at 40 minutes.
+LOCAL_STARTS = 0
 LOCAL_SPREAD_M = 40.0
 #: Passes of the local repair over the targets still beyond (it stops early when one gains
 #: nothing).
