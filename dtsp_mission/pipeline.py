@@ -22,7 +22,8 @@ from .dubins.path import check_radius
 from .errors import InputError, MissionTooLarge
 from .frame import LocalFrame, mission_centre
 from .mission import Mission, MissionSettings, build_mission
-from .mission.build import GUIDANCE_MARGINS, length_excess, targets_beyond, with_turn_margin
+from .mission.build import (GUIDANCE_MARGINS, check_storage, length_excess, targets_beyond,
+                            with_turn_margin)
 from .mission.sorties import Sortie, split_into_sorties
 from .planning import TilingUnavailable, get_planner
 from .planning.lower_bounds import LowerBound, lower_bound
@@ -38,8 +39,9 @@ class PlanRequest:
     the earth by ``origin`` (lat, lon) if given).  ``algorithm`` and ``parameters`` choose the
     planner; ``fallback`` plans with the Alternating Algorithm when the RBTA cannot tile.
     ``settings`` ask for a mission (None: the tour only); ``too_large`` says what becomes of
-    a mission too large for the vehicle: ``split`` into sorties, ``note`` it (the caller wants
-    the tour) or ``raise`` :class:`~dtsp_mission.errors.MissionTooLarge`; ``endurance_s``
+    a mission too large for the vehicle: ``split`` into sorties, ``raise``
+    :class:`~dtsp_mission.errors.MissionTooLarge`, or ``note`` it -- the caller wants only the
+    tour, so the mission is not designed, only checked against the storage; ``endurance_s``
     splits a longer flight into sorties.
     """
 
@@ -187,15 +189,18 @@ def _design_mission(request: PlanRequest, result: PlanResult,
     def design_step(k: int) -> Callable[[int, int], None]:
         """Progress of the k-th design, as its share of all the designs' flights."""
         return lambda done, total: progress((k + done / total) / designs)
+    if request.too_large == "note":     # only the tour is wanted: storage does not limit it
+        try:
+            check_storage(tour, frame, geodetic, settings)
+        except MissionTooLarge as error:
+            result.notes.append(f"as one mission this would not fit the vehicle: {error}")
+        return
     try:
         mission = build_mission(tour, frame, geodetic, settings,
                                 None if progress is None else design_step(0))
     except MissionTooLarge as error:
         if request.too_large == "raise":
             raise
-        if request.too_large == "note":     # only the tour is wanted: storage does not limit it
-            result.notes.append(f"as one mission this would not fit the vehicle: {error}")
-            return
         _split(request, result, f"as one mission it needs {error.needed} items (at least) but "
                                 f"the vehicle holds {error.capacity} (--max-items)")
         return

@@ -90,9 +90,10 @@ def test_fly_command_reports_every_target(mission, tmp_path):
 
 def test_plan_simulate_and_upload_in_one_go(tmp_path, start_vehicle, mission):
     vehicle = start_vehicle(mission, max_items=4000)   # with SD storage: the site needs ~1,800 items
-    out = tmp_path / "site.plan"
+    out = tmp_path / "site.plan"              # by geometry: the guidance design is tested elsewhere
     result = run("plan", SITE, "--radius", 80, "--alt", 120, "--airspeed", 22, "--max-items",
-                 4000, "--time-limit", 1, "-o", out, "--upload", f"udpout:127.0.0.1:{vehicle.port}")
+                 4000, "--time-limit", 1, "--design", "geometry", "-o", out,
+                 "--upload", f"udpout:127.0.0.1:{vehicle.port}")
     assert result.exit_code == 0, result.output
     assert out.exists() and "holds exactly the planned mission" in result.output
     assert len(vehicle.mission) == len(exporter_for(out).read(out).items) + 1

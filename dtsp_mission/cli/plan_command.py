@@ -209,8 +209,12 @@ def plan(targets_file, random_count, area_file, seed, origin, rho_m, airspeed_m_
     parameters = {"region": region} if algorithm in ("rbta", "auto") else {}
     if algorithm == "auto":
         parameters.update(time_limit_s=time_limit_s, seed=seed)
+    # Only tour files asked for: the mission is not designed (minutes of predicted flights
+    # for the guidance design), only checked against the vehicle's storage.  Without any
+    # output the mission is designed: its report is what was asked for.
+    tour_only = bool(writers) and not (needs_mission or connection or simulate or plot_file)
     request = PlanRequest(targets, rho, algorithm, parameters, fallback, origin, settings,
-                          too_large="split" if (needs_mission or connection or simulate) else "note",
+                          too_large="note" if tour_only else "split",
                           endurance_s=endurance_min and endurance_min * 60)
     from ..compiled import kernels_cached
     if not kernels_cached():

@@ -174,12 +174,8 @@ def _design_for_guidance(path: FlightPath, tour: Tour, frame: LocalFrame, target
     budget = settings.max_items - _fixed_items(settings, actions) - len(tail)
     needed = len(tour.targets_m)
     if budget < needed:
-        raise MissionTooLarge(
-            f"the mission needs at least {needed + _fixed_items(settings, actions) + len(tail)} items (one "
-            f"per target) but the vehicle holds {settings.max_items} (--max-items): allow more "
-            "if it has the space (ArduPilot with the mission on SD card holds about 4,300) or "
-            "split the targets into several missions",
-            needed + _fixed_items(settings, actions) + len(tail), settings.max_items)
+        raise _too_large_for_guidance(needed + _fixed_items(settings, actions) + len(tail),
+                                      settings.max_items)
     head = ([(Command.DO_CHANGE_SPEED, (0.0, float(settings.airspeed_m_s), -1.0, 0.0))]
             if settings.airspeed_m_s is not None else [])
     altitudes = (np.full(len(tour.targets_m), settings.altitude_m) if targets.altitudes_m is None
@@ -192,6 +188,14 @@ def _design_for_guidance(path: FlightPath, tour: Tour, frame: LocalFrame, target
                    aim_m=np.vstack([path.chain.pose_at(np.array([0.0]))[:, :2], design.aim_m,
                                     path.chain.pose_at(tail)[:, :2].reshape(-1, 2)]),
                    target_of=np.concatenate([[-1], design.target_of, np.full(len(tail), -1)]))
+
+
+def _too_large_for_guidance(needed: int, capacity: int) -> MissionTooLarge:
+    return MissionTooLarge(
+        f"the mission needs at least {needed} items (one per target) but the vehicle holds "
+        f"{capacity} (--max-items): allow more if it has the space (ArduPilot with the mission "
+        "on SD card holds about 4,300) or split the targets into several missions",
+        needed, capacity)
 
 
 def stored_position_m(frame: LocalFrame, points_m: np.ndarray) -> np.ndarray:
@@ -209,16 +213,22 @@ def _tail_waypoints(path: FlightPath, rho_m: float, settings: MissionSettings) -
     return chosen[chosen > path.tour_end_s_m + 1e-9]
 
 
-def build_mission(tour: Tour, frame: LocalFrame, targets: GeoTargets,
-                  settings: MissionSettings,
-                  progress: Callable[[int, int], None] | None = None) -> Mission:
-    """The mission that flies ``tour`` (planned in ``frame``) from take-off to the return.
+@dataclass(frozen=True)
+class _Prepared:
+    """What every mission of a tour starts from: the checked settings (the design the
+    autopilot can take), the flight path from take-off to the return, the action items, the
+    home and the notes so far."""
 
-    Guarantees: the waypoint polyline stays within the reported tolerance of the exact flight
-    path; every target is one NAV_WAYPOINT at its own coordinates; the item count fits
-    ``max_items`` (with ArduPilot's home slot) or :class:`InputError` says how many are needed.
-    ``progress(flights, rounds)`` follows the guidance design's predicted flights.
-    """
+    settings: MissionSettings
+    path: FlightPath
+    at_targets: "_AtTargets"
+    home_deg: tuple[float, float]
+    home_m: np.ndarray
+    notes: list[str]
+
+
+def _prepare(tour: Tour, frame: LocalFrame, targets: GeoTargets,
+             settings: MissionSettings) -> _Prepared:
     settings = settings.checked(tour.rho_m)
     notes: list[str] = []
     if settings.home_deg is None:
@@ -253,11 +263,45 @@ def build_mission(tour: Tour, frame: LocalFrame, targets: GeoTargets,
     if settings.launch_bearing_deg is None:
         notes.append(f"launch bearing not given: towards the first target "
                      f"({heading_to_bearing_deg(launch_heading):.0f} deg)")
-    design = None
     if settings.design == "guidance" and settings.autopilot != "ardupilot":
         notes.append("waypoints placed by geometry: the guidance design predicts ArduPlane's "
                      "navigation, and PX4's is not modelled")
         settings = replace(settings, design="geometry")
+    return _Prepared(settings, path, at_targets, (home_lat, home_lon), home_m, notes)
+
+
+def check_storage(tour: Tour, frame: LocalFrame, targets: GeoTargets,
+                  settings: MissionSettings) -> None:
+    """Raises :class:`MissionTooLarge` if no mission that :func:`build_mission` could make of
+    ``tour`` fits ``settings.max_items``: the guidance design needs at least one waypoint per
+    target, the geometric one its waypoints at ``--tolerance``.  Designs and predicts nothing
+    (milliseconds where :func:`build_mission` flies the mission for minutes)."""
+    prepared = _prepare(tour, frame, targets, settings)
+    settings, path, count = prepared.settings, prepared.path, prepared.at_targets.count
+    if settings.design == "guidance":
+        tail = _tail_waypoints(path, tour.rho_m, settings)
+        needed = len(tour.targets_m) + _fixed_items(settings, count) + len(tail)
+        if needed > settings.max_items:
+            raise _too_large_for_guidance(needed, settings.max_items)
+    else:
+        _fit_waypoints(path, tour.rho_m, settings, count)
+
+
+def build_mission(tour: Tour, frame: LocalFrame, targets: GeoTargets,
+                  settings: MissionSettings,
+                  progress: Callable[[int, int], None] | None = None) -> Mission:
+    """The mission that flies ``tour`` (planned in ``frame``) from take-off to the return.
+
+    Guarantees: the waypoint polyline stays within the reported tolerance of the exact flight
+    path; every target is one NAV_WAYPOINT at its own coordinates; the item count fits
+    ``max_items`` (with ArduPilot's home slot) or :class:`InputError` says how many are needed.
+    ``progress(flights, rounds)`` follows the guidance design's predicted flights.
+    """
+    prepared = _prepare(tour, frame, targets, settings)
+    settings, path, at_targets, notes = (prepared.settings, prepared.path, prepared.at_targets,
+                                         prepared.notes)
+    (home_lat, home_lon), home_m = prepared.home_deg, prepared.home_m
+    design = None
     if settings.design == "guidance":
         design = _design_for_guidance(path, tour, frame, targets, settings, at_targets.count,
                                       progress)

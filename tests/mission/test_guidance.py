@@ -4,13 +4,16 @@ flying the written mission again, independently, through the simulated vehicle's
 
 from __future__ import annotations
 
+from dataclasses import replace
+
 import numpy as np
 import pytest
 
 from dtsp_mission.autopilot.navigation import Airframe, closest_approach_m
-from dtsp_mission.errors import InputError
+from dtsp_mission.errors import InputError, MissionTooLarge
 from dtsp_mission.frame import LocalFrame
 from dtsp_mission.mission import MissionSettings, build_mission
+from dtsp_mission.mission.build import check_storage
 from dtsp_mission.planning import get_planner
 from dtsp_mission.sim.predict import predict_flight
 from dtsp_mission.targets.model import local_targets
@@ -64,6 +67,27 @@ def test_a_budget_below_one_item_per_target_is_refused_with_the_count():
     tour, frame, targets = sparse_site(30)
     with pytest.raises(InputError, match=r"needs at least 3\d items \(one per target\)"):
         build_mission(tour, frame, targets, MissionSettings(design="guidance", max_items=20))
+
+
+@pytest.mark.parametrize("design", ["guidance", "geometry"])
+def test_the_storage_check_without_a_design_agrees_with_the_design(design):
+    """check_storage (what a tour-only output asks) refuses exactly the budgets the design
+    refuses: the smallest budget it accepts builds a mission that fits, one less fails both."""
+    tour, frame, targets = sparse_site(12)
+    settings = MissionSettings(design=design, airspeed_m_s=22.0)
+    fits = []
+    for max_items in range(10, 200):
+        try:
+            check_storage(tour, frame, targets, replace(settings, max_items=max_items))
+            fits.append(max_items)
+        except MissionTooLarge:
+            pass
+    least = fits[0]
+    assert fits == list(range(least, 200))              # every larger budget passes too
+    mission = build_mission(tour, frame, targets, replace(settings, max_items=least))
+    assert mission.vehicle_item_count() <= least
+    with pytest.raises(MissionTooLarge):
+        build_mission(tour, frame, targets, replace(settings, max_items=least - 1))
 
 
 def test_the_same_input_gives_the_same_mission(designed):
