@@ -170,12 +170,8 @@ def _design_for_guidance(path: FlightPath, tour: Tour, frame: LocalFrame, target
     lead-out of a landing stays a geometric polyline."""
     parameters = settings.vehicle or ARDUPLANE_DEFAULTS
     airframe = Airframe.from_parameters(parameters, settings.airspeed_m_s)
-    tail = _tail_waypoints(path, tour.rho_m, settings)
+    tail = _guidance_tail(path, tour, settings, actions)
     budget = settings.max_items - _fixed_items(settings, actions) - len(tail)
-    needed = len(tour.targets_m)
-    if budget < needed:
-        raise _too_large_for_guidance(needed + _fixed_items(settings, actions) + len(tail),
-                                      settings.max_items)
     head = ([(Command.DO_CHANGE_SPEED, (0.0, float(settings.airspeed_m_s), -1.0, 0.0))]
             if settings.airspeed_m_s is not None else [])
     altitudes = (np.full(len(tour.targets_m), settings.altitude_m) if targets.altitudes_m is None
@@ -190,12 +186,20 @@ def _design_for_guidance(path: FlightPath, tour: Tour, frame: LocalFrame, target
                    target_of=np.concatenate([[-1], design.target_of, np.full(len(tail), -1)]))
 
 
-def _too_large_for_guidance(needed: int, capacity: int) -> MissionTooLarge:
-    return MissionTooLarge(
-        f"the mission needs at least {needed} items (one per target) but the vehicle holds "
-        f"{capacity} (--max-items): allow more if it has the space (ArduPilot with the mission "
-        "on SD card holds about 4,300) or split the targets into several missions",
-        needed, capacity)
+def _guidance_tail(path: FlightPath, tour: Tour, settings: MissionSettings,
+                   actions: int) -> np.ndarray:
+    """The tail waypoints of a guidance design (:func:`_tail_waypoints`), or
+    :class:`MissionTooLarge` if the least it needs -- one waypoint per target, the fixed items,
+    the tail -- does not fit ``settings.max_items``."""
+    tail = _tail_waypoints(path, tour.rho_m, settings)
+    needed = len(tour.targets_m) + _fixed_items(settings, actions) + len(tail)
+    if needed > settings.max_items:
+        raise MissionTooLarge(
+            f"the mission needs at least {needed} items (one per target) but the vehicle holds "
+            f"{settings.max_items} (--max-items): allow more if it has the space (ArduPilot with "
+            "the mission on SD card holds about 4,300) or split the targets into several "
+            "missions", needed, settings.max_items)
+    return tail
 
 
 def stored_position_m(frame: LocalFrame, points_m: np.ndarray) -> np.ndarray:
@@ -279,10 +283,7 @@ def check_storage(tour: Tour, frame: LocalFrame, targets: GeoTargets,
     prepared = _prepare(tour, frame, targets, settings)
     settings, path, count = prepared.settings, prepared.path, prepared.at_targets.count
     if settings.design == "guidance":
-        tail = _tail_waypoints(path, tour.rho_m, settings)
-        needed = len(tour.targets_m) + _fixed_items(settings, count) + len(tail)
-        if needed > settings.max_items:
-            raise _too_large_for_guidance(needed, settings.max_items)
+        _guidance_tail(path, tour, settings, count)
     else:
         _fit_waypoints(path, tour.rho_m, settings, count)
 
