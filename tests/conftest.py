@@ -29,6 +29,16 @@ def assert_valid_tour(tour: Tour) -> None:
     assert report.ok, report.summary() + "\n" + "\n".join(report.problems)
 
 
+def pytest_collection_modifyitems(items: list) -> None:
+    """The tests marked ``heavy`` first, longest first (``seconds``: as measured on 2 cores),
+    then the rest: started last, a test of minutes would keep one worker busy long after the
+    others are done."""
+    def key(item) -> tuple[bool, float]:
+        heavy = item.get_closest_marker("heavy")
+        return heavy is None, -(heavy.kwargs.get("seconds", 0.0) if heavy else 0.0)
+    items.sort(key=key)
+
+
 @pytest.fixture
 def rng() -> np.random.Generator:
     return np.random.default_rng(20261122)

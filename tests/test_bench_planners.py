@@ -4,7 +4,10 @@ import json
 import subprocess
 import sys
 
+import pytest
 
+
+@pytest.mark.heavy(seconds=16)
 def test_planner_bench_measures_every_planner_and_auto_is_shortest(tmp_path):
     result = subprocess.run(
         [sys.executable, "-m", "dtsp_mission.cli", "bench", "planners", "--sizes", "40,300",
@@ -33,6 +36,7 @@ def test_planner_bench_measures_every_planner_and_auto_is_shortest(tmp_path):
     assert (tmp_path / "plot.png").read_bytes()[:4] == b"\x89PNG"
 
 
+@pytest.mark.heavy(seconds=25)
 def test_the_anchor_is_a_peer_on_every_family_and_the_table_gives_each_length_over_it(tmp_path):
     result = subprocess.run(
         [sys.executable, "-m", "dtsp_mission.cli", "bench", "planners", "--sizes", "12",

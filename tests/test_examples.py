@@ -6,6 +6,8 @@ import os
 import subprocess
 import sys
 
+import pytest
+
 from dtsp_mission.export import read_mission
 from dtsp_mission.mission import AUTOPILOTS
 
@@ -27,6 +29,7 @@ def test_api_quickstart_plans_exports_and_uploads(tmp_path):
     assert len(read_mission(tmp_path / "survey.plan").items) == len(read_mission(tmp_path / "survey.waypoints").items)
 
 
+@pytest.mark.heavy(seconds=17)
 def test_polygon_survey_compares_planners_and_flies_the_shortest(tmp_path):
     out = run_example("polygon_survey.py", tmp_path, "--count", "300")
     table = {line.split()[0]: line.split() for line in out.splitlines()[2:8]}
@@ -35,6 +38,7 @@ def test_polygon_survey_compares_planners_and_flies_the_shortest(tmp_path):
     assert sum(f["properties"]["kind"] == "target" for f in geojson["features"]) == 300
 
 
+@pytest.mark.heavy(seconds=22)
 def test_fleet_batch_shares_the_site_between_three_aircraft(tmp_path):
     out = run_example("fleet_batch.py", tmp_path)
     rows = list(csv.DictReader((tmp_path / "fleet.csv").open()))
@@ -47,6 +51,7 @@ def test_fleet_batch_shares_the_site_between_three_aircraft(tmp_path):
     assert "272 targets on 3 aircraft" in out
 
 
+@pytest.mark.heavy(seconds=40)
 def test_site_inspection_plans_writes_and_flies_every_point(tmp_path):
     out = run_example("site_inspection.py", tmp_path, "--fly")
     for name in ("site.plan", "site.waypoints", "site.fence.plan", "site.kml"):

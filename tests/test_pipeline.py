@@ -43,6 +43,7 @@ def test_a_mission_too_large_is_split_noted_or_raised_as_asked():
         run_plan(PlanRequest(targets, 80.0, too_large="raise", **common))
 
 
+@pytest.mark.heavy(seconds=20)
 def test_sorties_are_planned_with_wider_turns_where_the_guidance_needs_them():
     """A sortie of a guidance design gets the wider turn radius a single mission gets where
     that holds more of its targets (sorties used to keep the radius asked for)."""

@@ -7,6 +7,7 @@ import sys
 from pathlib import Path
 
 import numpy as np
+import pytest
 from pymavlink import mavwp
 
 from conftest import assert_valid_tour
@@ -28,6 +29,7 @@ def run(*arguments):
                           capture_output=True, text=True, timeout=900)
 
 
+@pytest.mark.heavy(seconds=255)
 def test_site_example_to_every_format_and_a_plot_designed_for_a_stock_ardupilot(tmp_path):
     """The README's quick start (more formats): the guidance design fits the site in a stock
     ArduPlane, one waypoint per target, and the report says what it predicts."""
@@ -67,6 +69,7 @@ def test_site_example_to_every_format_and_a_plot_designed_for_a_stock_ardupilot(
         assert "predicted beyond --max-miss" not in result.stdout
 
 
+@pytest.mark.heavy(seconds=19)
 def test_geometry_design_over_the_stock_budget_is_split_into_sorties_and_a_coarser_tolerance_fits(tmp_path):
     result = run(SITE, "--radius", "80", "--design", "geometry", "--airspeed", "22",
                  "--max-items", "300", "-o", tmp_path / "m.plan", "-o", tmp_path / "tour.json")
@@ -97,6 +100,7 @@ def test_max_items_beyond_mavlink_is_refused(tmp_path):
     assert result.returncode == 2 and "at most 65535 items" in result.stderr
 
 
+@pytest.mark.heavy(seconds=20)
 def test_random_targets_in_a_polygon_are_seeded(tmp_path):
     first, second, other = (tmp_path / f"{n}.waypoints" for n in ("a", "b", "c"))
     common = ["--random", "60", "--area", AREA, "--airspeed", "20", "--max-bank", "30",
@@ -191,6 +195,7 @@ def test_sanity_checks_refuse_or_warn_with_a_clear_message(tmp_path):
     assert far.returncode == 0 and "home is 47.4 km from the nearest target: is --home right?" in far.stderr
 
 
+@pytest.mark.heavy(seconds=19)
 def test_a_flight_beyond_the_endurance_is_split_into_sorties_that_each_fit(tmp_path):
     rng = np.random.default_rng(3)
     targets = tmp_path / "t.csv"

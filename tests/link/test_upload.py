@@ -134,6 +134,7 @@ def test_an_upload_that_breaks_off_leaves_what_ardupilot_would_hold(start_vehicl
     assert len(vehicle.flight.items) == 30
 
 
+@pytest.mark.heavy(seconds=16)
 def test_signing_right_key_works_wrong_key_is_named(mission, start_vehicle):
     key = bytes(range(32))
     vehicle = start_vehicle(mission, signing_key=key)

@@ -202,6 +202,7 @@ def test_the_local_repair_holds_more_and_reports_what_the_mission_flies(monkeypa
     assert np.abs(flown - held).max() < 0.01    # the same flight: the design flies the stored positions
 
 
+@pytest.mark.heavy(seconds=16)
 def test_a_flight_that_strays_from_its_plan_is_planned_again_with_wider_turns():
     """At rho 80 m this site's predicted flight is more than 5 % longer than the planned one
     (the autopilot swings wide of turns it cannot hold and loops back to the targets after
@@ -220,6 +221,7 @@ def test_a_flight_that_strays_from_its_plan_is_planned_again_with_wider_turns():
     assert max(widened.summary["predicted_miss_m"]) <= 5.0
 
 
+@pytest.mark.heavy(seconds=29)
 def test_the_local_repair_s_other_starts_hold_what_small_steps_cannot(monkeypatch):
     """After four repair rounds on the fence, the local repair's pattern search alone leaves a
     post 12.9 m off (the corrections left its waypoints where no small step helps); given 100
