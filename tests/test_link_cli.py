@@ -145,7 +145,7 @@ def test_upload_a_tour_json_builds_the_mission_with_plan_options(tmp_path, start
     assert result.exit_code == 2 and "no frame origin" in result.output
 
 
-@pytest.mark.heavy(seconds=175)
+@pytest.mark.heavy(seconds=270)
 def test_a_site_too_big_for_the_vehicle_is_flown_as_sorties_it_accepts(tmp_path, start_vehicle):
     """The whole site does not fit a vehicle holding 120 items; plan splits it, the simulated
     vehicle with that real capacity accepts each sortie, and each sortie flies its targets."""
