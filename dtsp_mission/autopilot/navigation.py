@@ -14,12 +14,12 @@ the vehicle's parameters (:meth:`Airframe.from_parameters`).
 
 from __future__ import annotations
 
-import copy as _copy
 import math
 from dataclasses import dataclass, field, replace
 
 import numpy as np
 
+from . import flight_kernel as K
 from .commands import Command, Frame
 from .parameters import ARDUPLANE_DEFAULTS, VehicleParameters
 
@@ -41,6 +41,9 @@ SITL_TURN_EFFICIENCY = 0.73
 #: The time step the model's agreement with recorded ArduPlane flights was measured at
 #: (docs/arduplane-agreement.md): the flight that predicts, verifies and simulates a mission.
 MODEL_STEP_S = 0.02
+#: The take-off run of ArduPlane SITL's stock plane (fitted to the recorded climbs: 43 m run
+#: in the first 4 s, lift-off at 85 % of the cruise airspeed after about 3.5 s).
+TAKEOFF_ACCEL_M_S2 = 5.3
 #: LOITER_TURNS with the tangent exit leaves when the course is this close to the next waypoint.
 LOITER_EXIT_HEADING_RAD = math.radians(10.0)
 
@@ -79,6 +82,8 @@ class Airframe:
     turn_efficiency: float = 1.0
     #: How often the navigation runs (lateral demand, waypoint completion); 0: every step.
     navigation_hz: float = 0.0
+    #: ArduPlane's NAVL1_XTRACK_I: the cross-track integrator's gain (0: none).
+    xtrack_i_gain: float = 0.0
 
     @classmethod
     def from_parameters(cls, parameters: VehicleParameters = ARDUPLANE_DEFAULTS,
@@ -92,8 +97,9 @@ class Airframe:
                    roll_limit_deg=parameters.ROLL_LIMIT_DEG,
                    loiter_radius_m=parameters.WP_LOITER_RAD,
                    max_climb_m_s=parameters.TECS_CLMB_MAX, max_sink_m_s=parameters.TECS_SINK_MAX,
-                   altitude_time_constant_s=parameters.TECS_TIME_CONST, takeoff_accel_m_s2=7.0,
-                   turn_efficiency=SITL_TURN_EFFICIENCY, navigation_hz=parameters.SCHED_LOOP_RATE)
+                   altitude_time_constant_s=parameters.TECS_TIME_CONST, takeoff_accel_m_s2=TAKEOFF_ACCEL_M_S2,
+                   turn_efficiency=SITL_TURN_EFFICIENCY, navigation_hz=parameters.SCHED_LOOP_RATE,
+                   xtrack_i_gain=parameters.NAVL1_XTRACK_I)
 
     def max_bank_rad(self, airspeed_m_s: float) -> float:
         if self.roll_limit_deg is not None:
@@ -148,304 +154,292 @@ def local_items(wire: list, frame, home_amsl_m: float) -> list[LocalItem]:
     return items
 
 
-def _cross(ax: float, ay: float, bx: float, by: float) -> float:
-    return ax * by - ay * bx
+@dataclass(frozen=True)
+class Wind:
+    """A steady wind: ``speed_m_s`` from ``from_deg`` (degrees true the wind comes from, as in
+    a METAR and ArduPilot's ``SIM_WIND_DIR``), at full strength above ``full_altitude_m``
+    and weaker towards the ground as the square root of the height (ArduPilot SITL's default
+    profile, ``SIM_WIND_T_ALT`` 60 m)."""
+
+    speed_m_s: float = 0.0
+    from_deg: float = 0.0
+    full_altitude_m: float = 60.0
+
+    @property
+    def velocity_m_s(self) -> tuple[float, float]:
+        """(east, north) velocity of the air mass, m/s."""
+        towards = math.radians(self.from_deg + 180.0)
+        return self.speed_m_s * math.sin(towards), self.speed_m_s * math.cos(towards)
+
+    def __str__(self) -> str:
+        return "calm" if self.speed_m_s == 0 else f"{self.speed_m_s:g} m/s from {self.from_deg:g} deg"
 
 
-@dataclass
+CALM = Wind()
+#: The strongest wind the model takes: beyond it no small fixed wing flies a mission.
+MAX_WIND_M_S = 30.0
+
+
+def check_wind(wind: Wind, airspeed_m_s: float | None = None) -> Wind:
+    """``wind``, or :class:`~dtsp_mission.errors.InputError` saying why it cannot be flown
+    (not a number, negative, stronger than :data:`MAX_WIND_M_S` or than 70 % of the
+    airspeed: the aircraft would make little or no headway against it)."""
+    from ..errors import InputError
+    if not (math.isfinite(wind.speed_m_s) and math.isfinite(wind.from_deg)):
+        raise InputError(f"the wind must be finite numbers, got {wind.speed_m_s!r} m/s from "
+                         f"{wind.from_deg!r} deg")
+    if not 0.0 <= wind.speed_m_s <= MAX_WIND_M_S:
+        raise InputError(f"the wind speed must be from 0 to {MAX_WIND_M_S:g} m/s, got "
+                         f"{wind.speed_m_s:g}")
+    if airspeed_m_s is not None and wind.speed_m_s > 0.7 * airspeed_m_s:
+        raise InputError(f"a wind of {wind.speed_m_s:g} m/s is more than 70 % of the airspeed "
+                         f"({airspeed_m_s:g} m/s): the aircraft would make too little headway "
+                         "against it to fly a mission")
+    return wind
+
+
+def airframe_vector(airframe: Airframe, wind: Wind = CALM) -> np.ndarray:
+    """The airframe, its tuning and the wind as the compiled model's vector."""
+    v = np.zeros(K.AIRFRAME_SIZE)
+    v[K.A_AIRSPEED] = airframe.airspeed_m_s
+    v[K.A_MIN_RADIUS] = airframe.min_turn_radius_m
+    v[K.A_L1_PERIOD] = airframe.l1_period_s
+    v[K.A_WP_RADIUS] = airframe.wp_radius_m
+    v[K.A_ROLL_W] = airframe.roll_natural_rad_s
+    v[K.A_ROLL_Z] = airframe.roll_damping
+    v[K.A_L1_DAMPING] = airframe.l1_damping
+    v[K.A_ROLL_LIMIT] = math.nan if airframe.roll_limit_deg is None else airframe.roll_limit_deg
+    v[K.A_LOITER_RADIUS] = airframe.loiter_radius_m
+    v[K.A_CLIMB] = airframe.max_climb_m_s
+    v[K.A_SINK] = airframe.max_sink_m_s
+    v[K.A_ALT_TC] = airframe.altitude_time_constant_s
+    v[K.A_TKO_ACCEL] = airframe.takeoff_accel_m_s2
+    v[K.A_TKO_CLIMB] = airframe.takeoff_climb_m_s
+    v[K.A_TURN_EFFICIENCY] = airframe.turn_efficiency
+    v[K.A_NAV_HZ] = airframe.navigation_hz
+    v[K.A_WIND_X], v[K.A_WIND_Y] = wind.velocity_m_s
+    v[K.A_WIND_FULL_ALT] = wind.full_altitude_m
+    v[K.A_TKO_PITCH] = TAKEOFF_PITCH_DEG
+    v[K.A_XTRACK_I_GAIN] = airframe.xtrack_i_gain
+    return v
+
+
+@dataclass(frozen=True)
+class MissionArrays:
+    """A mission's items as the compiled model's columns."""
+
+    seq: np.ndarray          # int64
+    command: np.ndarray      # int64
+    position: np.ndarray     # (n, 3): x, y, altitude above home; NaN x/y without a position
+    params: np.ndarray       # (n, 4)
+    following: np.ndarray    # int64: next navigation item with a position after each, or -1
+
+    @classmethod
+    def of(cls, items: list[LocalItem]) -> "MissionArrays":
+        n = len(items)
+        command = np.array([int(i.command) for i in items], dtype=np.int64)
+        position = np.array([(i.x_m, i.y_m, i.alt_m) for i in items], dtype=float).reshape(n, 3)
+        params = np.array([i.params for i in items], dtype=float).reshape(n, 4)
+        following = np.full(n, -1, dtype=np.int64)
+        after = -1
+        for k in range(n - 1, -1, -1):
+            following[k] = after
+            if items[k].command in NAV_COMMANDS and not math.isnan(items[k].x_m):
+                after = k
+        return cls(np.array([i.seq for i in items], dtype=np.int64), command, position,
+                   params, following)
+
+    def with_positions(self, index: np.ndarray, xy_m: np.ndarray) -> "MissionArrays":
+        """The same mission with items ``index`` moved to ``xy_m`` (local frame)."""
+        position = self.position.copy()
+        position[index, :2] = xy_m
+        return replace(self, position=position)
+
+    def index_of(self, seq: int) -> int:
+        return int(np.searchsorted(self.seq, seq))
+
+
+_TRACK_CHUNK = 1 << 16
+#: Closest approaches are followed step by step only within this distance; a point never
+#: passed within it is measured exactly by a second flight of its own (rare: a miss that large).
+_APPROACH_CAP_M = 60.0
+
+
+@dataclass(frozen=True)
+class Checkpoint:
+    """A flight as an item became current: the flight (to continue on its own), the track
+    rows of the run recorded before it, and the least distance to each point so far."""
+
+    flight: "MissionFlight"
+    rows: int
+    closest_m: np.ndarray
+
+
+@dataclass(frozen=True)
+class FlightRun:
+    """What :meth:`MissionFlight.run` recorded: track rows (time, x, y, altitude), the
+    least distance to each point, the ground distance flown since the points began to be
+    measured (this flight's, from its start), and the checkpoints taken (seq -> checkpoint)."""
+
+    track: np.ndarray
+    closest_m: np.ndarray
+    measured_length_m: float
+    checkpoints: dict[int, Checkpoint]
+    stopped: int
+
+
 class MissionFlight:
     """Flies ``items`` from ``first_seq`` on, starting at home (0, 0) on the ground heading
-    ``heading_rad``.  ``reached`` lists (seq, time) of every item completed, in order."""
+    ``heading_rad``, in ``wind``: the compiled model of :mod:`.flight_kernel` behind a small
+    object.  :attr:`reached` lists (seq, time) of every item completed, in order."""
 
-    items: list[LocalItem]
-    airframe: Airframe
-    heading_rad: float
-    first_seq: int = 0
-    state: AircraftState = field(init=False)
-    reached: list[tuple[int, float]] = field(default_factory=list)
-    finished: bool = False
+    def __init__(self, items: list[LocalItem] | MissionArrays, airframe: Airframe,
+                 heading_rad: float, first_seq: int = 0, wind: Wind = CALM) -> None:
+        self.mission = items if isinstance(items, MissionArrays) else MissionArrays.of(items)
+        self.airframe = airframe
+        self.wind = wind
+        self._af = airframe_vector(airframe, wind)
+        n = len(self.mission.seq)
+        self._state = K.new_state(heading_rad, airframe.airspeed_m_s,
+                                  self.mission.index_of(first_seq) if n else 0)
+        self._reached = np.zeros((n + 1, 2))
+        self._counts = np.zeros(2, dtype=np.int64)
+        if n:
+            K.start(self._state, self.mission.command, self.mission.params, self._reached,
+                    self._counts)
+        else:
+            self._state[K.S_FINISHED] = 1.0
 
-    def __post_init__(self) -> None:
-        self.state = AircraftState(0.0, 0.0, 0.0, self.heading_rad, self.airframe.airspeed_m_s)
-        self._index = self.first_seq
-        self._previous = (0.0, 0.0, 0.0)     # the leg starts here (x, y, alt)
-        self._loiter: dict | None = None
-        self._demand = 0.0
-        self._next_navigation_s = 0.0
-        self._skip_instant_items()
-
-    def copy(self, items: list[LocalItem] | None = None) -> "MissionFlight":
+    def copy(self, items: list[LocalItem] | MissionArrays | None = None) -> "MissionFlight":
         """The flight as it is now, continuing on its own from here: stepping the copy leaves
         this one as it is.  ``items`` (same seqs, other positions or parameters) are flown
         from here on instead of the flight's own."""
-        other = _copy.copy(self)
-        other.items = self.items if items is None else items
-        other.state = replace(self.state)
-        other.reached = list(self.reached)
-        other._loiter = None if self._loiter is None else dict(self._loiter)
+        other = MissionFlight.__new__(MissionFlight)
+        other.mission = self.mission if items is None else (
+            items if isinstance(items, MissionArrays) else MissionArrays.of(items))
+        other.airframe, other.wind, other._af = self.airframe, self.wind, self._af
+        other._state = self._state.copy()
+        other._reached = self._reached.copy()
+        other._counts = self._counts.copy()
         return other
 
-    # -- mission sequencing ------------------------------------------------------------------
+    def _restored(self, state: np.ndarray, mission: MissionArrays | None = None) -> "MissionFlight":
+        """A copy of this flight at the checkpoint ``state`` (reach events after it dropped)."""
+        other = self.copy(mission)
+        other._state = state[:K.STATE_SIZE].copy()
+        time = other._state[K.S_TIME]
+        k = int(np.searchsorted(other._reached[:other._counts[0], 1], time, side="right"))
+        other._counts[0] = k
+        return other
 
     @property
-    def current(self) -> LocalItem | None:
-        return self.items[self._index] if self._index < len(self.items) else None
+    def state(self) -> AircraftState:
+        s = self._state
+        return AircraftState(float(s[K.S_X]), float(s[K.S_Y]), float(s[K.S_ALT]),
+                             float(s[K.S_HEADING]), float(s[K.S_AIRSPEED]), float(s[K.S_BANK]),
+                             float(s[K.S_BANK_RATE]), float(s[K.S_TIME]))
 
-    def _complete(self, leg_start: tuple[float, float, float] | None = None) -> None:
-        item = self.current
-        self.reached.append((item.seq, self.state.time_s))
-        if leg_start is not None:
-            self._previous = leg_start
-        elif item.command in NAV_COMMANDS and not math.isnan(item.x_m):
-            self._previous = (item.x_m, item.y_m, item.alt_m)
-        elif item.command == Command.NAV_TAKEOFF:
-            self._previous = (self.state.x_m, self.state.y_m, item.alt_m)
-        self._index += 1
-        self._loiter = None
-        self._skip_instant_items()
+    @property
+    def time_s(self) -> float:
+        return float(self._state[K.S_TIME])
 
-    def _skip_instant_items(self) -> None:
-        while (item := self.current) is not None and item.command not in NAV_COMMANDS:
-            if item.command == Command.DO_CHANGE_SPEED and item.params[1] > 0:
-                self.state.airspeed_m_s = float(item.params[1])
-            self.reached.append((item.seq, self.state.time_s))
-            self._index += 1
-        if self.current is None:
-            self.finished = True
+    @property
+    def ground_velocity_m_s(self) -> tuple[float, float]:
+        """(east, north) velocity over the ground."""
+        s = self._state
+        scale = 1.0 if s[K.S_ALT] >= self.wind.full_altitude_m else (
+            math.sqrt(max(s[K.S_ALT], 0.0) / self.wind.full_altitude_m))
+        wx, wy = self.wind.velocity_m_s
+        speed = s[K.S_AIRSPEED]
+        return (speed * math.cos(s[K.S_HEADING]) + wx * scale,
+                speed * math.sin(s[K.S_HEADING]) + wy * scale)
 
-    def _following(self) -> LocalItem | None:
-        """The next navigation item with a position after the current one."""
-        items = self.items
-        for k in range(self._index + 1, len(items)):
-            item = items[k]
-            if item.command in NAV_COMMANDS and not math.isnan(item.x_m):
-                return item
-        return None
+    @property
+    def finished(self) -> bool:
+        return bool(self._state[K.S_FINISHED])
 
-    def _next_turn_deg(self) -> float:
-        """Turn angle at the current waypoint, towards the next one (ArduPlane scales the
-        acceptance radius with it); 90 when the next item is no waypoint."""
-        item, following = self.current, self._following()
-        if following is None or following.command != Command.NAV_WAYPOINT:
-            return 90.0
-        a = math.atan2(item.y_m - self._previous[1], item.x_m - self._previous[0])
-        b = math.atan2(following.y_m - item.y_m, following.x_m - item.x_m)
-        return abs(math.degrees(math.remainder(b - a, 2 * math.pi)))
+    @property
+    def reached(self) -> list[tuple[int, float]]:
+        return self.reached_since(0)
 
-    # -- guidance ----------------------------------------------------------------------------
+    def reached_since(self, first: int) -> list[tuple[int, float]]:
+        """The reach events (seq, time) from the ``first``-th on."""
+        seqs = self.mission.seq
+        return [(int(seqs[int(i)]), float(t)) for i, t in self._reached[first:int(self._counts[0])]]
 
-    def _velocity(self) -> tuple[float, float]:
-        s = self.state
-        return s.airspeed_m_s * math.cos(s.heading_rad), s.airspeed_m_s * math.sin(s.heading_rad)
-
-    def _l1_lateral_accel(self, ax: float, ay: float, bx: float, by: float) -> float:
-        """ArduPlane's L1 law for the line from A to B: lateral acceleration, positive to the
-        left.  Behind A and farther than L1 it flies to A; well past B, to B."""
-        s = self.state
-        speed = s.airspeed_m_s
-        vx, vy = self._velocity()
-        l1 = self.airframe.l1_distance_m(speed)
-        tx, ty = bx - ax, by - ay
-        length = math.hypot(tx, ty)
-        if length < 1e-6:
-            tx, ty, length = bx - s.x_m, by - s.y_m, math.hypot(bx - s.x_m, by - s.y_m) or 1.0
-        tx, ty = tx / length, ty / length
-        rx, ry = s.x_m - ax, s.y_m - ay
-        distance_a = math.hypot(rx, ry)
-        along = rx * tx + ry * ty
-        if distance_a > l1 and along / distance_a < -0.7071:
-            eta = math.atan2(_cross(vx, vy, -rx, -ry), vx * -rx + vy * -ry)   # fly to A first
-        elif along > length + 3.0 * speed:
-            px, py = bx - s.x_m, by - s.y_m                                     # past B: to B
-            eta = math.atan2(_cross(vx, vy, px, py), vx * px + vy * py)
-        else:
-            nu2 = math.atan2(_cross(tx, ty, vx, vy), tx * vx + ty * vy)       # velocity vs track
-            nu1 = math.asin(max(-0.7071, min(0.7071, _cross(tx, ty, rx, ry) / l1)))
-            eta = -(nu1 + nu2)
-        eta = max(-math.pi / 2, min(math.pi / 2, eta))
-        damping = self.airframe.l1_damping
-        return 4 * damping ** 2 * speed ** 2 / l1 * math.sin(eta)
-
-    def _loiter_lateral_accel(self, cx: float, cy: float, radius: float, direction: int) -> tuple[float, bool]:
-        """ArduPlane's L1 loiter law around (cx, cy): lateral acceleration (positive to the
-        left) and whether it is on the circle (not capturing it).  ``direction`` +1 clockwise."""
-        s = self.state
-        speed = s.airspeed_m_s
-        vx, vy = self._velocity()
-        l1 = self.airframe.l1_distance_m(speed)
-        damping = self.airframe.l1_damping
-        omega = 2 * math.pi / self.airframe.l1_period_s
-        rx, ry = s.x_m - cx, s.y_m - cy
-        distance = math.hypot(rx, ry)
-        ux, uy = (rx / distance, ry / distance) if distance > 0.1 else (vx / speed, vy / speed)
-        # In ArduPilot's sense: right-positive, cross products of north-east vectors.
-        xtrack_velocity = -_cross(ux, uy, vx, vy)        # velocity across the radial line
-        ltrack_velocity = -(vx * ux + vy * uy)           # velocity towards the centre
-        nu = max(-math.pi / 2, min(math.pi / 2, math.atan2(xtrack_velocity, ltrack_velocity)))
-        capture = 4 * damping ** 2 * speed ** 2 / l1 * math.sin(nu)
-        error = distance - radius
-        pd = error * omega ** 2 + -ltrack_velocity * 2 * damping * omega
-        tangent = xtrack_velocity * direction
-        if ltrack_velocity < 0 and tangent < 0:
-            pd = max(pd, 0.0)
-        circle = direction * (pd + tangent ** 2 / max(0.5 * radius, radius + error))
-        if error > 0 and direction * capture < direction * circle:
-            return -capture, False
-        return -circle, True
-
-    # -- dynamics ----------------------------------------------------------------------------
-
-    def _fly(self, dt: float, lateral_accel: float, climb_rate: float, ground_factor: float = 1.0) -> None:
-        s = self.state
-        frame = self.airframe
-        limit = frame.max_bank_rad(s.airspeed_m_s)
-        command = max(-limit, min(limit, math.atan(lateral_accel / G)))
-        # Damped second-order roll response, integrated semi-implicitly.
-        w, z = frame.roll_natural_rad_s, frame.roll_damping
-        s.bank_rate_rad_s += (w * w * (command - s.bank_rad) - 2 * z * w * s.bank_rate_rad_s) * dt
-        s.bank_rad = max(-limit, min(limit, s.bank_rad + s.bank_rate_rad_s * dt))
-        ground_speed = s.airspeed_m_s * ground_factor
-        turn_rate = frame.turn_efficiency * G * math.tan(s.bank_rad) / s.airspeed_m_s
-        heading = s.heading_rad + turn_rate * dt
-        if abs(turn_rate) > 1e-12:    # exact arc of the step
-            radius = ground_speed / turn_rate
-            s.x_m += radius * (math.sin(heading) - math.sin(s.heading_rad))
-            s.y_m -= radius * (math.cos(heading) - math.cos(s.heading_rad))
-        else:
-            s.x_m += ground_speed * dt * math.cos(heading)
-            s.y_m += ground_speed * dt * math.sin(heading)
-        s.heading_rad = math.remainder(heading, 2 * math.pi)
-        s.alt_m += climb_rate * dt
-        s.time_s += dt
-
-    def _toward_alt(self, target_alt: float, dt: float) -> float:
-        frame = self.airframe
-        rate = (target_alt - self.state.alt_m) / max(dt, frame.altitude_time_constant_s)
-        return max(-frame.max_sink_m_s, min(frame.max_climb_m_s, rate))
-
-    # -- items -------------------------------------------------------------------------------
-
-    def _step_loiter_turns(self, item: LocalItem, dt: float) -> None:
-        """LOITER_TURNS: capture the circle, count the turns by the bearing to the centre,
-        then, with the tangent exit (param4), leave when the course points at the next
-        waypoint; the next leg starts where it left (from the centre without it).
-        LOITER_TIME: the same, for param1 seconds from the capture, on ArduPlane's own loiter
-        radius (it keeps only the sign of param3, the direction)."""
-        s = self.state
-        timed = item.command == Command.NAV_LOITER_TIME
-        radius = self.airframe.loiter_radius_m if timed else (abs(item.params[2])
-                                                             or self.airframe.loiter_radius_m)
-        direction = -1 if item.params[2] < 0 else 1
-        accel, on_circle = self._loiter_lateral_accel(item.x_m, item.y_m, radius, direction)
-        self._fly(dt, accel, self._toward_alt(item.alt_m, dt))
-        bearing = math.atan2(s.y_m - item.y_m, s.x_m - item.x_m)
-        loiter = self._loiter
-        if loiter is None:
-            if not on_circle:
-                return
-            loiter = self._loiter = {"bearing": bearing, "turned": 0.0, "counted": False,
-                                     "since_s": s.time_s}
-        loiter["turned"] += -direction * math.remainder(bearing - loiter["bearing"], 2 * math.pi)
-        loiter["bearing"] = bearing
-        if timed and s.time_s - loiter["since_s"] < max(item.params[0], 0.0):
-            return
-        if not timed and loiter["turned"] < 2 * math.pi * max(item.params[0], 0.0):
-            return
-        following = self._following()
-        if item.params[3] > 0 and following is not None:
-            # ArduPlane's exit test: at once if the next waypoint lies inside the circle (the
-            # course could never point at it), else the course within 10 deg of it (20 deg
-            # if it lies within 5 % outside), 10 deg more for each circle flown.
-            offset = math.hypot(following.x_m - item.x_m, following.y_m - item.y_m)
-            if offset >= 0.99 * radius:
-                base = 2.0 if offset < 1.05 * radius else 1.0
-                tolerance = LOITER_EXIT_HEADING_RAD * (base + math.floor(loiter["turned"] / (2 * math.pi)))
-                towards = math.atan2(following.y_m - s.y_m, following.x_m - s.x_m)
-                if abs(math.remainder(towards - s.heading_rad, 2 * math.pi)) > tolerance:
-                    return
-            self._complete((s.x_m, s.y_m, item.alt_m))
-            return
-        self._complete()
-
-    def _step_takeoff(self, item: LocalItem, dt: float) -> None:
-        """NAV_TAKEOFF: straight ahead until the item's altitude; the leg after it starts
-        where the climb ended, at the cruise airspeed."""
-        s, frame = self.state, self.airframe
-        if frame.takeoff_accel_m_s2 <= 0:
-            pitch = math.radians(item.params[0] or TAKEOFF_PITCH_DEG)
-            self._fly(dt, 0.0, s.airspeed_m_s * math.sin(pitch), math.cos(pitch))
-        else:
-            if self._loiter is None:                 # the take-off run starts from rest
-                self._loiter = {"speed": 0.0}
-            cruise = frame.airspeed_m_s
-            run = self._loiter
-            run["speed"] = min(run["speed"] + frame.takeoff_accel_m_s2 * dt, 1.16 * cruise)
-            climb = frame.takeoff_climb_m_s if run["speed"] >= 0.85 * cruise else 0.0
-            s.airspeed_m_s = max(run["speed"], 1e-3)
-            self._fly(dt, 0.0, climb)
-        if s.alt_m >= item.alt_m:
-            s.alt_m = item.alt_m
-            s.airspeed_m_s = frame.airspeed_m_s
-            self._complete()
-
-    def _navigation_tick(self) -> bool:
-        """Whether the navigation runs in this step (always, unless ``navigation_hz`` is set)."""
-        rate = self.airframe.navigation_hz
-        if rate <= 0:
-            return True
-        if self.state.time_s + 1e-9 >= self._next_navigation_s:
-            self._next_navigation_s = self.state.time_s + 1.0 / rate
-            return True
-        return False
+    @property
+    def current_seq(self) -> int | None:
+        i = int(self._state[K.S_INDEX])
+        return None if self.finished else int(self.mission.seq[i])
 
     def step(self, dt: float) -> None:
         """Advance ``dt`` seconds; completed items go to :attr:`reached`."""
-        if self.finished:
-            return
-        s, item = self.state, self.current
-        if item.command == Command.NAV_TAKEOFF:
-            self._step_takeoff(item, dt)
-            return
-        if item.command in (Command.NAV_LOITER_TURNS, Command.NAV_LOITER_TIME):
-            self._step_loiter_turns(item, dt)
-            return
-        if item.command == Command.NAV_RETURN_TO_LAUNCH:
-            target = (0.0, 0.0, self._previous[2])
-        else:
-            target = (item.x_m, item.y_m, item.alt_m)
-        ax, ay, a_alt = self._previous
-        bx, by, b_alt = target
-        leg = math.hypot(bx - ax, by - ay)
-        along = ((s.x_m - ax) * (bx - ax) + (s.y_m - ay) * (by - ay)) / leg if leg > 1e-9 else 0.0
-        fraction = min(max(along / leg, 0.0), 1.0) if leg > 1e-9 else 1.0
-        wanted_alt = a_alt + (b_alt - a_alt) * fraction       # altitude by leg progress
-        if item.command == Command.NAV_LAND:
-            sink = self.airframe.max_sink_m_s
-            climb = (wanted_alt - s.alt_m) / dt if fraction < 1 else -sink
-            climb = max(-sink, min(self.airframe.max_climb_m_s, climb))
-        else:
-            climb = self._toward_alt(wanted_alt, dt)
-        tick = self._navigation_tick()
-        if tick:
-            self._demand = self._l1_lateral_accel(ax, ay, bx, by)
-        self._fly(dt, self._demand, climb)
-        if not tick:
-            return
-        distance = math.hypot(bx - s.x_m, by - s.y_m)
-        past_finish_line = leg > 1e-9 and ((s.x_m - bx) * (bx - ax) + (s.y_m - by) * (by - ay)) > 0
-        if item.command == Command.NAV_LAND:
-            if s.alt_m <= 0.0:
-                s.alt_m = 0.0
-                self._complete()
-            return
-        acceptance = item.params[1] if item.command == Command.NAV_WAYPOINT else 0.0
-        if acceptance <= 0:
-            l1 = self.airframe.l1_distance_m(s.airspeed_m_s)
-            acceptance = min(self.airframe.wp_radius_m, l1) * min(self._next_turn_deg(), 90.0) / 90.0
-            if item.command == Command.NAV_RETURN_TO_LAUNCH:
-                acceptance = self.airframe.wp_radius_m
-        if distance <= acceptance or past_finish_line:
-            self._complete()
+        m = self.mission
+        K.step(self._state, self._af, m.command, m.position, m.params, m.following,
+               self._reached, self._counts, dt)
+
+    def run(self, dt: float, stop_after_seq: int | None = None, until_s: float = math.inf,
+            track: bool = True, marks: set[int] | None = None, points_m: np.ndarray | None = None,
+            closest_m: np.ndarray | None = None, measure_from_seq: int = 0) -> FlightRun:
+        """Steps of ``dt`` until item ``stop_after_seq`` is reached, the flight time reaches
+        ``until_s`` or the mission ends.  Records the track rows (time, x, y, altitude) if
+        ``track``; a checkpoint as each item of ``marks`` becomes current; and, from the moment
+        item ``measure_from_seq`` or a later one is current, the exact least distance of the
+        track (each step's chord) to each of ``points_m`` (local frame; starting from
+        ``closest_m``, else infinity) and the ground distance flown."""
+        m = self.mission
+        n = len(m.seq)
+        stop_index = -1 if stop_after_seq is None else m.index_of(stop_after_seq)
+        points = np.zeros((0, 2)) if points_m is None else np.ascontiguousarray(points_m, float).reshape(-1, 2)
+        best = (np.full(len(points), np.inf) if closest_m is None
+                else np.array(closest_m, dtype=float))
+        mark_array = np.zeros(n if marks else 0, dtype=np.bool_)
+        if marks:
+            for seq in marks:
+                k = m.index_of(seq)
+                if k < n and m.seq[k] == seq:
+                    mark_array[k] = True
+        saved = np.full((len(mark_array), K.STATE_SIZE + len(points)), np.nan)
+        chunks = []
+        buffer = np.empty((_TRACK_CHUNK if track else 0, 4))
+        origin = self.copy() if len(points) else None
+        measure_from = m.index_of(measure_from_seq)
+        while True:
+            counts = np.array([self._counts[0], 0], dtype=np.int64)
+            stopped = K.run(self._state, self._af, m.command, m.position, m.params, m.following,
+                            dt, stop_index, until_s, self._reached, counts, buffer,
+                            mark_array, saved, points, best, measure_from, _APPROACH_CAP_M)
+            self._counts[0] = counts[0]
+            if track:
+                chunks.append(buffer[:int(counts[1])].copy())
+            if stopped != K.STOP_TRACK_FULL:
+                break
+        far = np.flatnonzero(best >= _APPROACH_CAP_M)
+        if len(far):
+            # Points never passed within the cap: the same flight again, exact for them alone.
+            again = closest_m[far] if closest_m is not None else np.full(len(far), np.inf)
+            again = np.array(again, dtype=float)
+            count = np.zeros(2, dtype=np.int64)
+            count[0] = origin._counts[0]
+            K.run(origin._state, origin._af, m.command, m.position, m.params, m.following, dt,
+                  stop_index, until_s, origin._reached, count, np.empty((0, 4)),
+                  np.zeros(0, dtype=np.bool_), saved[:0, :K.STATE_SIZE + len(far)],
+                  np.ascontiguousarray(points[far]), again, measure_from, math.inf)
+            best[far] = again
+        track_rows = np.concatenate(chunks) if chunks else np.zeros((0, 4))
+        checkpoints = {}
+        for k in np.flatnonzero(mark_array):
+            if not np.isnan(saved[k, 0]):
+                rows = int(np.searchsorted(track_rows[:, 0], saved[k, K.S_TIME], side="right"))
+                checkpoints[int(m.seq[k])] = Checkpoint(self._restored(saved[k]), rows,
+                                                        saved[k, K.STATE_SIZE:].copy())
+        return FlightRun(track_rows, best, self.measured_length_m, checkpoints, int(stopped))
+
+    @property
+    def measured_length_m(self) -> float:
+        """Ground distance flown since points began to be measured (0 before)."""
+        start = self._state[K.S_MEASURE_START]
+        return 0.0 if math.isnan(start) else float(self._state[K.S_ODOMETER] - start)
 
 
 def closest_approach_m(track_xy: np.ndarray, points_xy: np.ndarray) -> np.ndarray:

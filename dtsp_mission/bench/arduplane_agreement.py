@@ -23,8 +23,8 @@ from pathlib import Path
 import numpy as np
 
 from ..autopilot import Command
-from ..autopilot.navigation import MODEL_STEP_S, Airframe, MissionFlight, closest_approach_m
-from ..autopilot.parameters import read_parameters
+from ..autopilot.navigation import MODEL_STEP_S, Airframe, MissionFlight, Wind, closest_approach_m
+from ..autopilot.parameters import parse_parameters, read_parameters
 from ..export import read_mission
 from ..frame import LocalFrame
 from ..sim.predict import predict_flight
@@ -87,14 +87,22 @@ def _length(xy: np.ndarray) -> float:
     return float(np.hypot(*np.diff(xy, axis=0).T).sum()) if len(xy) > 1 else 0.0
 
 
+def recorded_wind(folder: Path) -> Wind:
+    """The steady wind the SITL flew the case in (``SIM_WIND_SPD``, ``SIM_WIND_DIR``,
+    ``SIM_WIND_T_ALT`` of its ``params.parm``; calm without them)."""
+    values = parse_parameters((folder / "params.parm").read_text(), str(folder / "params.parm"))
+    return Wind(values.get("SIM_WIND_SPD", 0.0), values.get("SIM_WIND_DIR", 0.0),
+                values.get("SIM_WIND_T_ALT", 60.0))
+
+
 def fly_recorded_mission(folder: Path, airframe: Airframe | None = None, dt_s: float = MODEL_STEP_S,
                          ) -> tuple[MissionFlight, np.ndarray, LocalFrame]:
     """The model's flight of the case's mission (as ArduPilot stored it) with the case's
-    parameters, on until :data:`RECORDED_AFTER_S` after the last item as recorded: the
-    flight, its track rows (time, x, y, altitude) and the local frame at home."""
+    parameters and wind, on until :data:`RECORDED_AFTER_S` after the last item as recorded:
+    the flight, its track rows (time, x, y, altitude) and the local frame at home."""
     airframe = airframe or Airframe.from_parameters(read_parameters(folder / "params.parm"))
     predicted = predict_flight(read_mission(folder / "mission.plan"), airframe, dt_s,
-                               RECORDED_AFTER_S, 7200.0)
+                               RECORDED_AFTER_S, 7200.0, recorded_wind(folder))
     return predicted.flight, predicted.track, predicted.frame
 
 
@@ -116,7 +124,9 @@ def compare_case(folder: str | Path, airframe: Airframe | None = None) -> Agreem
 
     real_reached = {int(r["seq"]): float(r["time_s"]) for r in _rows(folder / "reached.csv")
                     if r["event"] == "reached" and r["time_s"]}
-    start_real, start_model = real_reached[1], model_reached.get(1, 0.0)
+    # the take-off's reach (seq 1), or where a recording lost it, the first item reached after it
+    start_real = real_reached.get(1, real_reached[min(real_reached)])
+    start_model = model_reached.get(1, 0.0)
     common = sorted(seq for seq in real_reached if seq in model_reached and seq > 1)
     end = common[-1]
     scale = (real_reached[end] - start_real) / max(model_reached[end] - start_model, 1e-9)

@@ -6,6 +6,7 @@ from __future__ import annotations
 import click
 import numpy as np
 
+from ..autopilot.navigation import CALM, check_wind
 from ..sim.fly import FlightCheck, fly_mission, targets_from, targets_in
 from . import console
 from .console import console_options, note, record, say
@@ -15,12 +16,14 @@ from .sim_command import airframe_from
 
 
 def run_flight_check(mission, targets, airframe, via: str, speedup: float,
-                     max_miss_m: float | None, max_items: int | None = None) -> FlightCheck:
+                     max_miss_m: float | None, max_items: int | None = None,
+                     wind=None) -> FlightCheck:
     """Fly, print the report, and fail (exit 1) when ``max_miss_m`` is exceeded (shared with
     ``plan --simulate``)."""
     progress, close = progress_reporter("flying")
     try:
         check = fly_mission(mission, targets, airframe, via=via, speedup=speedup, max_items=max_items,
+                            wind=wind or CALM,
                             progress=lambda stage, done, total: progress(done, total)
                             if stage == "flight" else None)
     finally:
@@ -72,7 +75,7 @@ def print_check(check: FlightCheck) -> None:
 @apply(console_options)
 @reports_errors
 def fly(mission_file, rho_m, airspeed_m_s, max_bank_deg, speedup, vehicle_params_file,
-        l1_period_s, via, format_name, max_miss_m, max_items, targets_file, quiet,
+        l1_period_s, wind, via, format_name, max_miss_m, max_items, targets_file, quiet,
         as_json) -> None:
     """Upload MISSION_FILE to the simulated fixed wing, fly it, and print per-target miss
     distances and the flight time.
@@ -97,7 +100,10 @@ def fly(mission_file, rho_m, airspeed_m_s, max_bank_deg, speedup, vehicle_params
                  "aims them off the targets): give --targets FILE to measure to the targets")
         else:
             targets = targets_from(read_geodetic_targets(targets_file))
-        run_flight_check(mission, targets, airframe, via, speedup, max_miss_m, max_items)
+        if wind is not None:
+            check_wind(wind, airframe.airspeed_m_s)
+            say(f"wind {wind}")
+        run_flight_check(mission, targets, airframe, via, speedup, max_miss_m, max_items, wind)
     finally:
         console.finish()       # the summary also when --max-miss fails the check
 

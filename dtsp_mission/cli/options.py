@@ -4,6 +4,7 @@ the one place where library errors become CLI errors."""
 from __future__ import annotations
 
 import functools
+import math
 import sys
 import time
 from typing import Callable
@@ -58,6 +59,30 @@ class LatLonType(click.ParamType):
 
 LAT_LON = LatLonType()
 
+
+class WindType(click.ParamType):
+    """``SPEED@FROM_DEG``: m/s, and degrees true the wind comes from (as in a METAR)."""
+
+    name = "SPEED@FROM_DEG"
+
+    def convert(self, value, param, ctx):
+        from ..autopilot.navigation import Wind, check_wind
+        from ..errors import InputError
+        if isinstance(value, Wind):
+            return value
+        try:
+            speed, direction = (float(part) for part in str(value).split("@"))
+        except ValueError:
+            self.fail(f"{value!r} is not SPEED@FROM_DEG (m/s @ degrees true the wind comes "
+                      "from, for example 6@270 for 6 m/s from the west)", param, ctx)
+        try:
+            return check_wind(Wind(speed, direction % 360.0 if math.isfinite(direction) else direction))
+        except InputError as error:
+            self.fail(str(error), param, ctx)
+
+
+WIND = WindType()
+
 #: The vehicle, defined once for every command that plans or flies.
 vehicle_options = [
     click.option("--radius", "rho_m", type=float, metavar="METRES",
@@ -109,15 +134,16 @@ mission_options = [
 
 def mission_settings(autopilot, altitude_m, airspeed_m_s, home_deg, home_amsl_m,
                      launch_bearing_deg, landing_bearing_deg, return_mode, design, max_miss_m,
-                     tolerance_m, max_items, vehicle=None, **actions):
+                     tolerance_m, max_items, vehicle=None, wind=None, **actions):
     """The :class:`MissionSettings` of the :data:`mission_options` values (``vehicle``: the
     :class:`~dtsp_mission.autopilot.parameters.VehicleParameters` the mission is for;
     ``actions``: photo, roi, gimbal_pitch_deg, loiter_radius_m)."""
+    from ..autopilot.navigation import CALM
     from ..mission import MissionSettings
     return MissionSettings(autopilot, altitude_m, airspeed_m_s, home_deg, home_amsl_m,
                            launch_bearing_deg, landing_bearing_deg, return_mode, tolerance_m,
                            max_items, design=design, max_miss_m=max_miss_m, vehicle=vehicle,
-                           **actions)
+                           wind=wind if wind is not None else CALM, **actions)
 
 
 def apply(options: list) -> Callable:
@@ -185,6 +211,10 @@ simulation_options = [
     click.option("--l1-period", "l1_period_s", type=float, metavar="S",
                  help="Override NAVL1_PERIOD, the L1 navigation period of the simulated "
                       "autopilot."),
+    click.option("--wind", type=WIND, metavar="SPEED@FROM_DEG",
+                 help="Steady wind: m/s @ degrees true it comes from (6@270: 6 m/s from the "
+                      "west), full strength above 60 m.  The simulated aircraft flies in it; "
+                      "`plan` also designs the mission for it.  Default calm."),
 ]
 
 

@@ -25,6 +25,7 @@ from ..targets.actions import TargetActions, check_loiter_turns
 from ..targets.geojson_file import read_geojson
 from . import console
 from .console import console_options, note, record, say
+from ..autopilot.navigation import CALM
 from .options import (LAT_LON, UserError, apply, link_options, mission_options,
                       mission_settings, progress_reporter, reports_errors, seed_option, simulation_options,
                       turn_radius_from, vehicle_options)
@@ -146,7 +147,7 @@ def plan(targets_file, random_count, area_file, seed, origin, rho_m, airspeed_m_
          fallback, outputs, format_name,
          plot_file, connection, via, verify, signing_key_file, transfer_timeout_s, endurance_min,
          photo, roi, gimbal_pitch_deg, loiter_specs, loiter_radius_m, simulate, speedup,
-         vehicle_params_file, l1_period_s, quiet, as_json) -> None:
+         vehicle_params_file, l1_period_s, wind, quiet, as_json) -> None:
     """Plan a Dubins tour through the targets and write it as a mission.
 
     TARGETS_FILE: CSV with lat,lon columns (optional alt, name), or local x,y metres (with
@@ -199,7 +200,7 @@ def plan(targets_file, random_count, area_file, seed, origin, rho_m, airspeed_m_
                                     launch_bearing_deg, landing_bearing_deg, return_mode, design,
                                     max_miss_m, tolerance_m, max_items, designed_for,
                                     photo=photo, roi=roi, gimbal_pitch_deg=gimbal_pitch_deg,
-                                    loiter_radius_m=loiter_radius_m)
+                                    loiter_radius_m=loiter_radius_m, wind=wind or CALM)
         settings.checked(rho)          # refused before planning, not after
         if autopilot == "px4" and any(writer.name == "waypoints" for _, writer in writers):
             note("a .waypoints file holds the home in its row 0, as QGroundControl, Mission "
@@ -267,7 +268,7 @@ def plan(targets_file, random_count, area_file, seed, origin, rho_m, airspeed_m_
             if sorties:
                 say(f"sortie {k + 1} of {len(sorties)}:")
             run_flight_check(flown.for_vehicle(), planned_targets(flown), airframe, via,
-                             speedup, max_miss_m, max_items)
+                             speedup, max_miss_m, max_items, wind)
             console.current().summary.setdefault("simulated", []).append(console.current().summary.pop("flight"))
     if connection:
         from .upload_command import run_upload
@@ -393,6 +394,11 @@ def _report_tour(result: PlanResult) -> None:
                    f"{tour.report['leftover_length_m']:,.1f} m")
 
 
+def _wind_text(wind: dict) -> str:
+    return ("calm" if wind["speed_m_s"] == 0 else
+            f"in a wind of {wind['speed_m_s']:g} m/s from {wind['from_deg']:g} deg")
+
+
 def _report_mission(mission) -> None:
     summary = mission.summary
     flavour = "ArduPilot" if mission.autopilot == Autopilot.ARDUPILOTMEGA else "PX4"
@@ -402,7 +408,7 @@ def _report_mission(mission) -> None:
                    f"per target, {summary['shaping_waypoints']} shaping waypoints), "
                    f"{summary['vehicle_slots']} vehicle slots; designed for the autopilot's "
                    f"guidance: targets passed within median {np.median(misses):.1f} m, max "
-                   f"{misses.max():.1f} m in the flight model")
+                   f"{misses.max():.1f} m in the flight model, {_wind_text(summary['design_wind'])}")
         say(f"  predicted flight {summary['predicted_flight_m'] / 1e3:,.2f} km against "
                    f"{summary['planned_flight_m'] / 1e3:,.2f} km of exact path (take-off to the "
                    "last target)")
@@ -413,7 +419,7 @@ def _report_mission(mission) -> None:
            flight_length_m=summary["flight_length_m"], flight_time_s=summary.get("flight_time_s"))
     if "predicted_miss_m" in summary:
         record(predicted_miss_m=summary["predicted_miss_m"],
-               predicted_flight_m=summary["predicted_flight_m"])
+               predicted_flight_m=summary["predicted_flight_m"], design_wind=summary["design_wind"])
     if "actions" in summary:
         say("  actions at the targets: " + ", ".join(f"{count} {role}" for role, count in
                                                       summary["actions"].items()))

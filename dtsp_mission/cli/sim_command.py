@@ -15,6 +15,7 @@ from ..autopilot.navigation import G, SITL_TURN_EFFICIENCY, Airframe
 from ..autopilot.parameters import ARDUPLANE_DEFAULTS, VehicleParameters, read_parameters
 from ..sim.vehicle import SimulatedVehicle, VehicleSettings
 from ..upload.connection import read_signing_key
+from ..autopilot.navigation import CALM, check_wind
 from .options import (LAT_LON, UserError, apply, reports_errors, simulation_options,
                       vehicle_options)
 
@@ -78,7 +79,8 @@ def airframe_from(vehicle_params_file, airspeed_m_s, max_bank_deg, l1_period_s,
               "MAV_CMD_MISSION_START).")
 @reports_errors
 def sim(listen, gcs, home_deg, home_amsl_m, autopilot, rho_m, airspeed_m_s, max_bank_deg,
-        speedup, vehicle_params_file, l1_period_s, max_items, signing_key_file, autostart) -> None:
+        speedup, vehicle_params_file, l1_period_s, wind, max_items, signing_key_file,
+        autostart) -> None:
     """Run a simulated fixed-wing vehicle that accepts missions over MAVLink and flies them.
 
     Example: dtsp-mission sim --home 46.805,6.941 --radius 80 --airspeed 22 --autostart
@@ -89,7 +91,8 @@ def sim(listen, gcs, home_deg, home_amsl_m, autopilot, rho_m, airspeed_m_s, max_
     settings = VehicleSettings(Home(*home_deg, home_amsl_m), AUTOPILOTS[autopilot], airframe,
                                speedup, max_items=max_items, autostart=autostart,
                                signing_key=read_signing_key(signing_key_file) if signing_key_file else None,
-                               parameters=parameters)
+                               parameters=parameters,
+                               wind=check_wind(wind or CALM, airframe.airspeed_m_s))
     try:
         vehicle = SimulatedVehicle(settings, gcs=_address(gcs) if gcs else None, listen=listen)
     except ValueError as error:
@@ -98,7 +101,7 @@ def sim(listen, gcs, home_deg, home_amsl_m, autopilot, rho_m, airspeed_m_s, max_
         raise UserError(f"cannot listen on {listen}: {error.strerror}") from None
     with vehicle:
         click.echo(f"simulated {autopilot} fixed wing at {home_deg[0]:.6f},{home_deg[1]:.6f}; "
-                   f"{source}; connect with {vehicle.connection} (Ctrl-C stops)")
+                   f"{source}; wind {settings.wind}; connect with {vehicle.connection} (Ctrl-C stops)")
         uploads, reached = 0, 0
         try:
             while True:

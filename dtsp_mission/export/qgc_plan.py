@@ -39,7 +39,7 @@ def plan_dict(mission: Mission) -> dict[str, Any]:
             "doJumpId": number,
         })
     home = mission.home
-    return {
+    document = {
         "fileType": "Plan",
         "version": 1,
         "groundStation": "dtsp-mission",
@@ -57,6 +57,9 @@ def plan_dict(mission: Mission) -> dict[str, Any]:
         "geoFence": {"circles": [], "polygons": [], "version": 2},
         "rallyPoints": {"points": [], "version": 2},
     }
+    if "design_wind" in mission.summary:     # readers ignore keys they do not know
+        document["dtspMission"] = {"designWind": mission.summary["design_wind"]}
+    return document
 
 
 def _is_number(value: Any) -> bool:

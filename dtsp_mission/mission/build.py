@@ -24,7 +24,7 @@ from ..targets.model import MAX_ALTITUDE_M
 from ..tour import Tour
 from ..vehicle import bearing_to_heading_rad, heading_to_bearing_deg
 from ..autopilot.commands import AUTOPILOTS, Command, Frame
-from ..autopilot.navigation import Airframe
+from ..autopilot.navigation import CALM, Airframe, Wind, check_wind
 from ..autopilot.parameters import ARDUPLANE_DEFAULTS, VehicleParameters
 from ..autopilot.storage import MAVLINK_MAX_ITEMS, capacity
 from . import actions as action_items
@@ -69,6 +69,7 @@ class MissionSettings:
     roi: bool = False                         # the camera pointed at every target
     gimbal_pitch_deg: float | None = None     # gimbal pitch for targets without their own
     loiter_radius_m: float | None = None      # default actions.LOITER_RADIUS_RHO * rho
+    wind: Wind = CALM                         # guidance: the steady wind the mission is designed for
 
     def checked(self, rho_m: float) -> "MissionSettings":
         """The settings with defaults filled in, or :class:`InputError` saying what is wrong."""
@@ -111,6 +112,7 @@ class MissionSettings:
             raise InputError(f"loiter_radius_m (--loiter-radius) must be from the turn radius "
                              f"({rho_m:g} m) to 2,550 m (the most ArduPilot stores), got "
                              f"{self.loiter_radius_m!r}")
+        check_wind(self.wind, self.airspeed_m_s or (self.vehicle or ARDUPLANE_DEFAULTS).AIRSPEED_CRUISE)
         for name in ("launch_bearing_deg", "landing_bearing_deg"):
             value = getattr(self, name)
             if value is not None and not math.isfinite(value):
@@ -179,7 +181,8 @@ def _design_for_guidance(path: FlightPath, tour: Tour, frame: LocalFrame, target
     altitudes = np.where(np.isnan(altitudes), settings.altitude_m, altitudes)   # not given
     design = design_waypoints(path, tour.targets_m, altitudes, airframe, settings.max_miss_m, budget, head,
                               settings.target_acceptance_m, progress=progress,
-                              as_stored=lambda points: stored_position_m(frame, points))
+                              as_stored=lambda points: stored_position_m(frame, points),
+                              wind=settings.wind)
     return replace(design, s_m=np.concatenate([[0.0], design.s_m, tail]),
                    aim_m=np.vstack([path.chain.pose_at(np.array([0.0]))[:, :2], design.aim_m,
                                     path.chain.pose_at(tail)[:, :2].reshape(-1, 2)]),
@@ -332,7 +335,9 @@ def build_mission(tour: Tour, frame: LocalFrame, targets: GeoTargets,
                        predicted_flight_m=design.predicted_length_m,
                        planned_flight_m=design.planned_length_m,
                        shaping_waypoints=sum(i.role == "shaping" for i in items),
-                       design_rounds=design.rounds)
+                       design_rounds=design.rounds,
+                       design_wind={"speed_m_s": settings.wind.speed_m_s,
+                                    "from_deg": settings.wind.from_deg})
     autopilot = AUTOPILOTS[settings.autopilot]
     mission = Mission(tuple(items), Home(home_lat, home_lon, settings.home_altitude_amsl_m),
                       autopilot, settings.airspeed_m_s, tour.rho_m, tolerance, frame, tour, path,

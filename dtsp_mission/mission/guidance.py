@@ -54,8 +54,8 @@ from typing import Callable
 import numpy as np
 
 from ..autopilot.commands import Command
-from ..autopilot.navigation import (MODEL_STEP_S, Airframe, LocalItem, MissionFlight,
-                                    closest_approach_m)
+from ..autopilot.navigation import (CALM, MODEL_STEP_S, Airframe, LocalItem, MissionArrays,
+                                    MissionFlight, Wind)
 from .actions import loiter_turns_params
 from .model import FlightPath
 
@@ -122,45 +122,23 @@ class GuidanceDesign:
         return int((self.target_of < 0).sum())
 
 
-def _fly(items: list[LocalItem], airframe: Airframe, heading_rad: float,
-         stop_after_seq: int) -> tuple[np.ndarray, dict[int, float]]:
-    """Track rows (time, x, y) and reach times, until item ``stop_after_seq`` is reached."""
-    flight = MissionFlight(items, airframe, heading_rad, 1)
-    track = [(0.0, 0.0, 0.0)]
-    _continue(flight, track, stop_after_seq, PREDICTION_STEP_S)
-    return np.array(track), dict(flight.reached)
+def _fly(items: list[LocalItem], airframe: Airframe, heading_rad: float, stop_after_seq: int,
+         targets_m: np.ndarray, wind: Wind = CALM
+         ) -> tuple[np.ndarray, dict[int, float], np.ndarray, float]:
+    """Track rows (time, x, y), reach times, each target's closest approach after the take-off
+    (``targets_m`` in the flight's frame) and the length flown from the take-off's end, until
+    item ``stop_after_seq`` is reached."""
+    flight = MissionFlight(items, airframe, heading_rad, 1, wind)
+    run = flight.run(PREDICTION_STEP_S, stop_after_seq, points_m=targets_m,
+                     measure_from_seq=_AFTER_TAKEOFF, until_s=FLIGHT_LIMIT_S)
+    track = np.vstack([np.zeros((1, 3)), run.track[:, :3]])
+    return track, dict(flight.reached), run.closest_m, run.measured_length_m
 
 
-def _continue(flight: MissionFlight, track: list, stop_after_seq: int, step_s: float,
-              marks: set[int] | None = None) -> dict[int, tuple[MissionFlight, int]]:
-    """Steps ``flight`` by ``step_s`` until item ``stop_after_seq`` is reached, its rows (time,
-    x, y) added to ``track``; returns, for each seq of ``marks``, a copy of the flight as that item became
-    the current one and the number of track rows then."""
-    saved: dict[int, tuple[MissionFlight, int]] = {}
-    seen = None
-    limit = 36000.0
-    while not flight.finished and flight.state.time_s < limit:
-        if marks is not None and flight.current.seq != seen:
-            seen = flight.current.seq
-            if seen in marks:
-                saved[seen] = (flight.copy(), len(track))
-        flight.step(step_s)
-        state = flight.state
-        track.append((state.time_s, state.x_m, state.y_m))
-        if flight.reached and flight.reached[-1][0] >= stop_after_seq:
-            break
-    return saved
-
-
-def _measured(track: np.ndarray, reached: dict[int, float], last_seq: int, home: np.ndarray,
-              targets_m: np.ndarray) -> tuple[np.ndarray, float]:
-    """Per target, the closest approach of the track (rows time, x, y relative to ``home``)
-    after the take-off; and the track's length from the take-off's end to item ``last_seq``."""
-    flown = track[:, 1:] + home
-    after_takeoff = track[:, 0] >= reached.get(1, 0.0)
-    span = after_takeoff & (track[:, 0] <= reached.get(last_seq, np.inf))
-    return (closest_approach_m(flown[after_takeoff], targets_m),
-            float(np.hypot(*np.diff(flown[span], axis=0).T).sum()))
+#: The first item after the take-off (seq 1): the misses and length count from it.
+_AFTER_TAKEOFF = 2
+#: No predicted flight goes on longer than this (s).
+FLIGHT_LIMIT_S = 36000.0
 
 
 def _nearest_in(track_xy: np.ndarray, point: np.ndarray) -> np.ndarray:
@@ -307,7 +285,7 @@ VERIFY_MARGIN_M = 0.05
 
 def _refine(aim: np.ndarray, target_of: list[int], items: list[LocalItem], seqs: list[int],
             home: np.ndarray, targets_m: np.ndarray, max_miss_m: float, airframe: Airframe,
-            heading: float, stored: Callable[[np.ndarray], np.ndarray]
+            heading: float, stored: Callable[[np.ndarray], np.ndarray], wind: Wind = CALM
             ) -> tuple[np.ndarray, np.ndarray, float, int]:
     """(aims, per-target miss, predicted length, whole flights) after up to
     :data:`REFINE_PASSES` passes of the local repair over the targets still beyond
@@ -316,19 +294,19 @@ def _refine(aim: np.ndarray, target_of: list[int], items: list[LocalItem], seqs:
     (:meth:`_Trial.cost_of`); a moved waypoint is placed ``stored``.  Each pass ends with the whole mission flown afresh from the
     start: the misses and length returned are those of the best such flight (a resumed flight
     can differ from a fresh one by a few decimetres), so they are what the mission flies."""
-    items = list(items)
+    mission = MissionArrays.of(items)
     seq_set = set(seqs)
     last = len(items) - 2
+    local_targets = targets_m - home
 
-    def afresh(items: list[LocalItem]):
-        flight = MissionFlight(items, airframe, heading, 1)
-        track: list = [(0.0, 0.0, 0.0)]
-        marks = _continue(flight, track, last, VERIFY_STEP_S, seq_set)
-        reached = dict(flight.reached)
-        miss, length = _measured(np.array(track), reached, last, home, targets_m)
-        return marks, track, reached, miss, length, _Trial.cost_of(miss, max_miss_m)
+    def afresh(mission: MissionArrays):
+        flight = MissionFlight(mission, airframe, heading, 1, wind)
+        run = flight.run(VERIFY_STEP_S, last, marks=seq_set, points_m=local_targets,
+                         measure_from_seq=_AFTER_TAKEOFF, track=False, until_s=FLIGHT_LIMIT_S)
+        miss = run.closest_m
+        return run.checkpoints, miss, run.measured_length_m, _Trial.cost_of(miss, max_miss_m)
 
-    marks, track, reached, miss, length, cost = afresh(items)
+    marks, miss, length, cost = afresh(mission)
     flights = 1
     aim = aim.copy()
     best = (aim, miss, length, cost.sum())
@@ -340,28 +318,21 @@ def _refine(aim: np.ndarray, target_of: list[int], items: list[LocalItem], seqs:
             if t < 0 or cost[t] <= 0.0:
                 continue
             begin, end = max(k - LOCAL_BACK, 0), min(k + LOCAL_AHEAD, len(seqs) - 1)
-            start, rows = marks[seqs[begin]]
+            checkpoint = marks[seqs[begin]]
+            start = checkpoint.flight
             window = [target_of[j] for j in range(begin, end + 1) if target_of[j] >= 0]
-            before = np.array(track[:rows])
-            before = before[before[:, 0] >= reached.get(1, 0.0)]
-            fixed = (closest_approach_m(before[:, 1:] + home, targets_m[window]) if len(before) > 1
-                     else np.full(len(window), np.inf))
+            fixed = checkpoint.closest_m[window]
             movable = list(range(max(k - LOCAL_MOVE, begin + 1 if begin > 0 else 0), k + 1))
+            movable_index = np.array([seqs[j] for j in movable], dtype=np.int64)
 
-            def with_aims(points: np.ndarray) -> list[LocalItem]:
-                changed = list(items)
-                for j in movable:
-                    x, y = points[j] - home
-                    changed[seqs[j]] = replace(items[seqs[j]], x_m=float(x), y_m=float(y))
-                return changed
+            def with_aims(points: np.ndarray) -> MissionArrays:
+                return mission.with_positions(movable_index, points[movable] - home)
 
             def local_cost(points: np.ndarray) -> float:
-                trial = start.copy(with_aims(points))
-                rows_ = [track[rows - 1]]
-                _continue(trial, rows_, seqs[end], VERIFY_STEP_S)
-                flown = np.array(rows_)[:, 1:] + home
-                m = np.minimum(fixed, closest_approach_m(flown, targets_m[window]))
-                return float(_Trial.cost_of(m, max_miss_m).sum())
+                run = start.copy(with_aims(points)).run(
+                    VERIFY_STEP_S, seqs[end], track=False, points_m=local_targets[window],
+                    closest_m=fixed, measure_from_seq=_AFTER_TAKEOFF, until_s=FLIGHT_LIMIT_S)
+                return float(_Trial.cost_of(run.closest_m, max_miss_m).sum())
 
             def descend(candidate: np.ndarray, current: float, step_m: float
                         ) -> tuple[np.ndarray, float]:
@@ -417,21 +388,19 @@ def _refine(aim: np.ndarray, target_of: list[int], items: list[LocalItem], seqs:
             if not np.any(candidate != aim):
                 continue
             changed = with_aims(candidate)
-            again = start.copy(changed)
-            rows_ = list(track[:rows])
-            new_marks = _continue(again, rows_, last, VERIFY_STEP_S,
-                                  {q for q in seq_set if q >= seqs[begin]})
+            run = start.copy(changed).run(
+                VERIFY_STEP_S, last, track=False, marks={q for q in seq_set if q >= seqs[begin]},
+                points_m=local_targets, closest_m=checkpoint.closest_m,
+                measure_from_seq=_AFTER_TAKEOFF, until_s=FLIGHT_LIMIT_S)
             flights += 1
-            new_reached = dict(again.reached)
-            new_miss, new_length = _measured(np.array(rows_), new_reached, last, home, targets_m)
-            new_cost = _Trial.cost_of(new_miss, max_miss_m)
+            new_cost = _Trial.cost_of(run.closest_m, max_miss_m)
             if new_cost.sum() < cost.sum():
-                aim, items, track, reached = candidate, changed, rows_, new_reached
-                miss, length, cost = new_miss, new_length, new_cost
-                marks.update(new_marks)
+                aim, mission = candidate, changed
+                miss, length, cost = run.closest_m, run.measured_length_m, new_cost
+                marks.update(run.checkpoints)
         if cost.sum() >= before_pass:
             break
-        marks, track, reached, miss, length, cost = afresh(items)
+        marks, miss, length, cost = afresh(mission)
         flights += 1
         if cost.sum() < best[3]:
             best = (aim, miss, length, cost.sum())
@@ -443,7 +412,8 @@ def design_waypoints(path: FlightPath, targets_m: np.ndarray, altitudes_m: np.nd
                      head_items: list[tuple[int, tuple[float, float, float, float]]] = (),
                      target_acceptance_m: float = 5.0, rounds: int | None = None,
                      progress: Callable[[int, int], None] | None = None,
-                     as_stored: Callable[[np.ndarray], np.ndarray] | None = None) -> GuidanceDesign:
+                     as_stored: Callable[[np.ndarray], np.ndarray] | None = None,
+                     wind: Wind = CALM) -> GuidanceDesign:
     """The waypoints (``budget`` at most) that make the modelled autopilot pass every target
     of ``path`` within ``max_miss_m``, as far as ``rounds`` predicted flights of the repair and
     the local repair's passes allow.
@@ -493,10 +463,10 @@ def design_waypoints(path: FlightPath, targets_m: np.ndarray, altitudes_m: np.nd
         items, seqs = _local_items(takeoff, takeoff_alt, head_items, aim - home,
                                    path.altitude_m(np.asarray(s_wp)), target_of,
                                    target_acceptance_m, loiters)
-        track, reached = _fly(items, airframe, heading, len(items) - 2)
+        track, reached, miss, predicted = _fly(items, airframe, heading, len(items) - 2,
+                                               targets_m - home, wind)
         flown = track[:, 1:] + home
         after_takeoff = track[:, 0] >= reached.get(1, 0.0)
-        miss, predicted = _measured(track, reached, len(items) - 2, home, targets_m)
         start_s = reached.get(1, 0.0)
         design = GuidanceDesign(np.asarray(s_wp), aim, np.asarray(target_of), miss, predicted,
                                 float(path.target_s_m.max()), flights)
@@ -557,7 +527,7 @@ def design_waypoints(path: FlightPath, targets_m: np.ndarray, altitudes_m: np.nd
                                target_acceptance_m, loiters)
     verify_miss_m = max(max_miss_m - VERIFY_MARGIN_M, 0.5 * max_miss_m)
     aim, miss, length, flown = _refine(design.aim_m, best.target_of, items, seqs, home,
-                                       targets_m, verify_miss_m, airframe, heading, stored)
+                                       targets_m, verify_miss_m, airframe, heading, stored, wind)
     flights += flown
     if progress is not None:
         progress(min(flights, rounds), rounds)

@@ -21,7 +21,7 @@ from ..errors import LinkError
 from ..mission import Command, VehicleMission
 from ..upload import UploadReport, upload_mission
 from ..upload.pymavlink_link import GCS_COMPONENT_ID, GCS_SYSTEM_ID, use_mavlink2
-from ..autopilot.navigation import Airframe, closest_approach_m
+from ..autopilot.navigation import CALM, Airframe, Wind, closest_approach_m
 from .vehicle import MAV_CMD_MISSION_START, SimulatedVehicle, VehicleSettings
 
 
@@ -101,11 +101,12 @@ class FlightCheck:
 def fly_mission(mission: VehicleMission, targets: Targets, airframe: Airframe,
                 via: str = "pymavlink", speedup: float = 50.0, telemetry_hz: float = 10.0,
                 progress: Callable[[str, int, int], None] | None = None,
-                timeout_s: float | None = None, max_items: int | None = None) -> FlightCheck:
+                timeout_s: float | None = None, max_items: int | None = None,
+                wind: Wind = CALM) -> FlightCheck:
     """Upload ``mission`` to a simulated vehicle with ``airframe`` and ``max_items`` mission
-    slots (None: a stock vehicle's), fly it, and measure."""
+    slots (None: a stock vehicle's), fly it in ``wind``, and measure."""
     settings = VehicleSettings(mission.home, mission.autopilot, airframe, speedup,
-                               telemetry_hz=telemetry_hz, max_items=max_items)
+                               telemetry_hz=telemetry_hz, max_items=max_items, wind=wind)
     with SimulatedVehicle(settings) as vehicle:
         connection = f"udpout:127.0.0.1:{vehicle.port}"
         report = upload_mission(mission, connection, via=via,

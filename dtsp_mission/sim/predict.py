@@ -13,7 +13,8 @@ from dataclasses import dataclass
 import numpy as np
 
 from ..autopilot import Command, stored_item
-from ..autopilot.navigation import MODEL_STEP_S, Airframe, LocalItem, MissionFlight, local_items
+from ..autopilot.navigation import (CALM, MODEL_STEP_S, Airframe, LocalItem, MissionFlight, Wind,
+                                    local_items)
 from ..frame import LocalFrame
 from ..mission import VehicleMission
 from ..upload.wire import first_mission_seq, to_wire
@@ -33,9 +34,10 @@ class PredictedFlight:
 
 
 def predict_flight(mission: VehicleMission, airframe: Airframe, dt_s: float = MODEL_STEP_S,
-                   after_last_s: float = 0.0, limit_s: float = 36000.0) -> PredictedFlight:
-    """Fly ``mission`` until its last waypoint or loiter is reached, then ``after_last_s`` more
-    (in RTL, as ArduPlane goes on after a mission without one)."""
+                   after_last_s: float = 0.0, limit_s: float = 36000.0,
+                   wind: Wind = CALM) -> PredictedFlight:
+    """Fly ``mission`` in ``wind`` until its last waypoint or loiter is reached, then
+    ``after_last_s`` more (in RTL, as ArduPlane goes on after a mission without one)."""
     home = mission.home
     frame = LocalFrame(home.latitude_deg, home.longitude_deg)
     wire = [stored_item(item, mission.autopilot) for item in to_wire(mission)]
@@ -47,14 +49,11 @@ def predict_flight(mission: VehicleMission, airframe: Airframe, dt_s: float = MO
     ahead = next((i for i in items[first:] if not math.isnan(i.x_m)
                   and math.hypot(i.x_m, i.y_m) > 1.0), None)
     heading = math.atan2(ahead.y_m, ahead.x_m) if ahead is not None else 0.0
-    flight = MissionFlight(items, airframe, heading, first)
+    flight = MissionFlight(items, airframe, heading, first, wind)
     last = max((i.seq for i in items if i.command in _FLOWN), default=first)
-    track = [(0.0, 0.0, 0.0, 0.0)]
-    stop_s = math.inf
-    while not flight.finished and flight.state.time_s < min(stop_s, limit_s):
-        flight.step(dt_s)
-        s = flight.state
-        track.append((s.time_s, s.x_m, s.y_m, s.alt_m))
-        if stop_s == math.inf and flight.reached and flight.reached[-1][0] >= last:
-            stop_s = s.time_s + after_last_s
-    return PredictedFlight(np.array(track), dict(flight.reached), frame, flight)
+    head = np.zeros((1, 4))
+    run = flight.run(dt_s, stop_after_seq=last, until_s=limit_s)
+    track = [head, run.track]
+    if not flight.finished and after_last_s > 0:
+        track.append(flight.run(dt_s, until_s=min(flight.time_s + after_last_s, limit_s)).track)
+    return PredictedFlight(np.concatenate(track), dict(flight.reached), frame, flight)

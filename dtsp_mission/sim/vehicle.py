@@ -27,7 +27,8 @@ from dataclasses import dataclass, field
 import numpy as np
 from pymavlink.dialects.v20 import common as mavlink2
 
-from ..autopilot.navigation import MODEL_STEP_S, Airframe, LocalItem, MissionFlight, local_items
+from ..autopilot.navigation import (CALM, MODEL_STEP_S, Airframe, LocalItem, MissionFlight, Wind,
+                                    local_items)
 from ..autopilot.parameters import ARDUPLANE_DEFAULTS, NAMES, VehicleParameters, parameter_name
 from ..autopilot.storage import MissionStore, stored_item
 from ..frame import LocalFrame
@@ -73,6 +74,7 @@ class VehicleSettings:
     upload_timeout_s: float = 8.0     # an upload without an item this long is cancelled
                                       # (ArduPilot's MissionItemProtocol: 8 s)
     parameters: VehicleParameters = ARDUPLANE_DEFAULTS   # what it answers PARAM_REQUEST_READ with
+    wind: Wind = CALM                 # the steady wind it flies in
 
 
 @dataclass
@@ -378,7 +380,8 @@ class SimulatedVehicle:
             self.log = FlightLog()
             self.finished.clear()
             self._completed = 0
-            self.flight = MissionFlight(items, self.settings.airframe, heading, first)
+            self.flight = MissionFlight(items, self.settings.airframe, heading, first,
+                                        self.settings.wind)
             return True
 
     def _flight_loop(self) -> None:
@@ -402,14 +405,13 @@ class SimulatedVehicle:
                 steps += 1
                 state = flight.state
                 self.log.samples.append((state.time_s, state.x_m, state.y_m, state.alt_m))
-                while self._completed < len(flight.reached):
-                    self.log.reached.append(flight.reached[self._completed])
+                for seq, at in flight.reached_since(self._completed):
+                    self.log.reached.append((seq, at))
                     self._completed += 1
-                    seq = flight.reached[self._completed - 1][0]
                     self._emit(lambda e, seq=seq: e.mission_item_reached_send(seq))
                     self._emit(lambda e, seq=seq: e.mission_current_send(seq + 1))
                 if steps % publish_every == 0 or flight.finished:
-                    self._publish(state)
+                    self._publish(state, flight.ground_velocity_m_s)
                 if flight.finished:
                     self.finished.set()
             if settings.speedup > 0:
@@ -418,16 +420,16 @@ class SimulatedVehicle:
                 if ahead > 0.002:
                     time.sleep(ahead)
 
-    def _publish(self, state) -> None:
+    def _publish(self, state, ground_velocity_m_s: tuple[float, float]) -> None:
         """GLOBAL_POSITION_INT, from the vehicle's own encoder: in order with
         MISSION_ITEM_REACHED (MAVSDK's telemetry server queues positions and, at a high
         speed-up, delivers them after the mission's last item was reported)."""
         latitude, longitude = self.frame.to_geodetic(np.array([[state.x_m, state.y_m]]))
-        speed = state.airspeed_m_s
+        east, north = ground_velocity_m_s
         home = self.settings.home
         bearing = heading_to_bearing_deg(state.heading_rad)
         self._emit(lambda e: e.global_position_int_send(
             int(state.time_s * 1000) & 0xFFFFFFFF, degrees_to_e7(float(latitude[0])),
             degrees_to_e7(float(longitude[0])), round((home.altitude_amsl_m + state.alt_m) * 1000),
-            round(state.alt_m * 1000), round(100 * speed * math.sin(state.heading_rad)),
-            round(100 * speed * math.cos(state.heading_rad)), 0, round(bearing * 100) % 36000))
+            round(state.alt_m * 1000), round(100 * north), round(100 * east), 0,
+            round(bearing * 100) % 36000))

@@ -131,7 +131,7 @@ def test_an_upload_that_breaks_off_leaves_what_ardupilot_would_hold(start_vehicl
     assert len(held) == 30 and held == vehicle.mission
     assert not differences(wire[:10], held[:10], mission.autopilot)
     assert vehicle.start_mission()                            # what it flies is what it holds
-    assert len(vehicle.flight.items) == 30
+    assert len(vehicle.flight.mission.seq) == 30
 
 
 @pytest.mark.heavy(seconds=16)
