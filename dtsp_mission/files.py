@@ -7,6 +7,7 @@ file in the same directory, is flushed to disk, and replaces the target in one r
 from __future__ import annotations
 
 import os
+import stat
 import tempfile
 from pathlib import Path
 
@@ -45,10 +46,28 @@ def read_text(path: str | os.PathLike) -> str:
                               f"{error.start})") from None
 
 
+def check_replaceable(path: str | os.PathLike) -> None:
+    """:class:`FileAccessError` unless ``path`` is absent or a regular file (an output never
+    replaces a device, a FIFO, a socket or a folder)."""
+    path = Path(path)
+    try:
+        mode = path.stat().st_mode
+    except FileNotFoundError:
+        return
+    except OSError as error:
+        raise FileAccessError(f"{path}: cannot be checked ({error.strerror})") from None
+    if not stat.S_ISREG(mode):
+        kind = ("a folder" if stat.S_ISDIR(mode) else "a device" if stat.S_ISCHR(mode) or stat.S_ISBLK(mode)
+                else "a FIFO" if stat.S_ISFIFO(mode) else "a socket" if stat.S_ISSOCK(mode)
+                else "not a regular file")
+        raise FileAccessError(f"{path} is {kind}: outputs only replace regular files")
+
+
 def write_atomic(path: str | os.PathLike, content: str | bytes) -> Path:
     """Write ``content`` to ``path`` so that readers see the old file or the whole new one."""
     path = Path(path)
     data = content.encode("utf-8") if isinstance(content, str) else content
+    check_replaceable(path)
     directory = path.parent if str(path.parent) else Path(".")
     if not directory.is_dir():
         raise FileAccessError(f"{path}: directory {directory} does not exist")

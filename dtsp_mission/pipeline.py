@@ -142,6 +142,11 @@ def _bound(positions: np.ndarray, rho_m: float, area_m: np.ndarray | None) -> Lo
     return lower_bound(positions, rho_m, area)
 
 
+#: The widest turn radius a mission is planned with: a turn circle 40 km across already fills a
+#: good part of the flat mission frame (about 150 km from its centre).
+MAX_PLAN_RADIUS_M = 20_000.0
+
+
 def run_plan(request: PlanRequest,
              progress: Callable[[float], None] | None = None,
              design_progress: Callable[[float], None] | None = None) -> PlanResult:
@@ -153,6 +158,10 @@ def run_plan(request: PlanRequest,
     :class:`~dtsp_mission.errors.InputError` before any planning.
     """
     check_radius(request.rho_m)
+    if request.rho_m > MAX_PLAN_RADIUS_M:
+        raise InputError(f"a turn radius of {request.rho_m:g} m is beyond reason for a mission "
+                         f"(at most {MAX_PLAN_RADIUS_M:,.0f} m: the turn alone would span more than "
+                         "the mission frame holds); is it in metres?")
     local, geodetic, frame = place(request.targets, request.origin)
     if len(local) < 2:
         raise InputError(f"{len(local)} target(s) after merging duplicates; a tour needs at "
@@ -213,10 +222,10 @@ def _design_mission(request: PlanRequest, result: PlanResult,
             result.notes.append(
                 f"planned with a turn radius of {widened.rho_m:g} m instead of "
                 f"{mission.rho_m:g} m so that the autopilot's guidance can hold the turns: "
-                f"{targets_beyond(mission, settings.max_miss_m)} -> "
-                f"{targets_beyond(widened, settings.max_miss_m)} targets predicted beyond "
-                f"--max-miss, the predicted flight {100 * length_excess(mission):+.1f} % -> "
-                f"{100 * length_excess(widened):+.1f} % of the planned one")
+                f"{targets_beyond(mission)} -> {targets_beyond(widened)} targets predicted "
+                f"beyond {settings.design_limit_m:g} m, the predicted flight "
+                f"{mission.summary['predicted_flight_m'] / 1e3:,.2f} -> "
+                f"{widened.summary['predicted_flight_m'] / 1e3:,.2f} km")
             mission = widened
     result.mission = mission
     flight_s = mission.summary.get("flight_time_s", 0.0)

@@ -51,7 +51,7 @@ SQUARE = [[6.9, 46.8], [6.96, 46.8], [6.96, 46.84], [6.9, 46.84], [6.9, 46.8]]
 
 def test_geojson_points_multipoint_and_area(tmp_path):
     data = {"type": "FeatureCollection", "features": [
-        {"type": "Feature", "properties": {"name": "a"}, "geometry": {"type": "Point", "coordinates": [6.91, 46.81, 400]}},
+        {"type": "Feature", "properties": {"name": "a"}, "geometry": {"type": "Point", "coordinates": [6.91, 46.81]}},
         {"type": "Feature", "properties": None, "geometry": {"type": "MultiPoint", "coordinates": [[6.92, 46.82], [6.93, 46.83]]}},
         polygon(SQUARE)]}
     targets = read_targets(write(tmp_path, "t.geojson", data))
@@ -68,6 +68,9 @@ def test_geojson_points_multipoint_and_area(tmp_path):
         {"type": "Feature", "properties": {}, "geometry": {"type": "Point", "coordinates": [6.91, 46.8]}}]},
      "on every target or on none"),
     ({"type": "Point", "coordinates": [6.9, 95]}, "latitude 95.0"),
+    ({"type": "Point", "coordinates": [6.9, 46.8, 400]}, "third coordinate"),
+    ({"type": "Feature", "properties": "camera", "geometry": {"type": "Point", "coordinates": [6.9, 46.8]}},
+     "must be an object"),
     ([1, 2], "not GeoJSON"),
 ])
 def test_geojson_errors(tmp_path, data, message):

@@ -27,7 +27,7 @@ import math
 import numba
 import numpy as np
 
-_JIT = dict(cache=True, error_model="numpy")
+_JIT = dict(cache=True, error_model="numpy", nogil=True)
 
 G = 9.80665
 

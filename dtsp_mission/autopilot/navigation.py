@@ -109,6 +109,13 @@ class Airframe:
     def l1_distance_m(self, speed_m_s: float) -> float:
         return max(self.l1_damping * self.l1_period_s * speed_m_s / math.pi, 1.0)
 
+    @property
+    def tightest_turn_m(self) -> float:
+        """The smallest radius the model flies in still air at the cruise airspeed: full bank,
+        at its turn efficiency."""
+        v = self.airspeed_m_s
+        return v * v / (self.turn_efficiency * G * math.tan(self.max_bank_rad(v)))
+
 
 @dataclass(frozen=True)
 class LocalItem:

@@ -51,6 +51,39 @@ class VehicleParameters:
 ARDUPLANE_DEFAULTS = VehicleParameters()
 NAMES = tuple(f.name for f in fields(VehicleParameters))
 
+#: The values each parameter may take (ArduPlane's documented ranges, narrowed where the
+#: documented value cannot fly a mission: a roll limit below 10 deg, an airspeed below 5 m/s).
+RANGES: dict[str, tuple[float, float]] = {
+    "NAVL1_PERIOD": (1.0, 60.0), "NAVL1_DAMPING": (0.6, 1.0), "NAVL1_XTRACK_I": (0.0, 0.1),
+    "WP_RADIUS": (1.0, 32767.0), "WP_MAX_RADIUS": (0.0, 32767.0),
+    "WP_LOITER_RAD": (-32767.0, 32767.0), "AIRSPEED_CRUISE": (5.0, 100.0),
+    "ROLL_LIMIT_DEG": (10.0, 90.0), "TECS_CLMB_MAX": (0.1, 20.0), "TECS_SINK_MAX": (0.1, 20.0),
+    "TECS_TIME_CONST": (3.0, 10.0), "TKOFF_LVL_PITCH": (0.0, 30.0),
+    "RTL_ALTITUDE": (-1.0, 32767.0), "RTL_RADIUS": (-32767.0, 32767.0),
+    "SCHED_LOOP_RATE": (50.0, 400.0),
+}
+
+
+def check_parameters(values: dict[str, float], where: str = "parameters") -> None:
+    """:class:`FileFormatError` for a navigation parameter out of its range (or not a number)
+    and for a name that is not one but nearly spells one (a typo that would silently leave
+    the parameter at its default)."""
+    import difflib
+    for name, value in values.items():
+        if name in RANGES:
+            low, high = RANGES[name]
+            if not (math.isfinite(value) and low <= value <= high):
+                raise FileFormatError(f"{where}: {name} {value:g} is out of its range "
+                                      f"{low:g} .. {high:g}")
+            if name == "WP_LOITER_RAD" and abs(value) < 1.0:
+                raise FileFormatError(f"{where}: WP_LOITER_RAD must be at least 1 m either way, "
+                                      f"got {value:g}")
+        else:
+            close = difflib.get_close_matches(name, NAMES, n=1, cutoff=0.9)
+            if close:
+                raise FileFormatError(f"{where}: {name} is not an ArduPlane parameter; did you "
+                                      f"mean {close[0]}?")
+
 
 def parameter_name(param_id: str | bytes) -> str:
     """A PARAM_* message's ``param_id`` as text (pymavlink gives str or bytes, NUL-padded)."""
@@ -86,4 +119,6 @@ def read_parameters(path: str | os.PathLike) -> VehicleParameters:
         text = Path(path).read_text(encoding="utf-8", errors="replace")
     except OSError as error:
         raise FileAccessError(f"cannot read the vehicle parameters {path}: {error.strerror}") from None
-    return parameters_from(parse_parameters(text, str(path)))
+    values = parse_parameters(text, str(path))
+    check_parameters(values, str(path))
+    return parameters_from(values)

@@ -195,6 +195,17 @@ def capacity(autopilot: Autopilot) -> int:
 
 #: MAV_MISSION_RESULT values the store answers with.
 ACCEPTED, ERROR, NO_SPACE = 0, 1, 4
+UNSUPPORTED_FRAME, UNSUPPORTED = 2, 3
+
+#: The MAV_CMD values a mission takes (ArduPilot's AP_Mission converts these; what else it is
+#: sent it answers MAV_MISSION_UNSUPPORTED): navigation, conditions, DO_ and camera commands.
+MISSION_COMMANDS = frozenset(
+    {16, 17, 18, 19, 20, 21, 22, 30, 31, 42, 82, 83, 84, 85, 92, 93, 94, 112, 114, 115}
+    | set(range(176, 225)) | {300, 2000, 2001, 2003, 2004, 2500, 2501, 3000, 42600, 42702, 42703}
+    | {int(c) for c in Command})
+#: The frames a mission item's position may be given in (global, relative, terrain; their _INT
+#: forms; MAV_FRAME_MISSION for items without a position).
+MISSION_FRAMES = frozenset({0, 2, 3, 5, 6, 10, 11})
 
 
 class MissionStore:
@@ -248,8 +259,15 @@ class MissionStore:
         return ACCEPTED
 
     def write(self, item: WireItem) -> int:
-        """Item ``item.seq`` of the upload begun last: ACCEPTED, or ERROR for a seq beyond the
-        end of what is stored (ArduPilot) or out of order (PX4)."""
+        """Item ``item.seq`` of the upload begun last: ACCEPTED; UNSUPPORTED for a command the
+        autopilot's mission does not know, UNSUPPORTED_FRAME for a position in a frame it does
+        not take (home's placeholder at seq 0 aside); ERROR for a seq beyond the end of what is
+        stored (ArduPilot) or out of order (PX4)."""
+        if item.seq > 0 or self.home is None:
+            if item.command not in MISSION_COMMANDS:
+                return UNSUPPORTED
+            if item.frame not in MISSION_FRAMES:
+                return UNSUPPORTED_FRAME
         stored = replace(stored_item(item, self.autopilot), current=0)
         if not self.in_place:
             if self._staged is None or item.seq != len(self._staged):

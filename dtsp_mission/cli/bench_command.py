@@ -4,7 +4,7 @@ from __future__ import annotations
 
 import click
 
-from .options import UserError, reports_errors, seed_option
+from .options import FiniteFloatRange, UserError, reports_errors, seed_option
 
 
 bench_radius_option = click.option("--radius", "rho_m", type=float, default=100.0,
@@ -68,7 +68,7 @@ def _sizes(ctx, param, value: str) -> list[int]:
 @click.option("--anchor", is_flag=True,
               help="Add the LKH-3 GTSP anchor (K = 8, 16, 32 headings, Noon-Bean, elkai) as a "
                    "peer and give every length over it; needs pip install -e \".[bench]\".")
-@click.option("--time-limit", "time_limit_s", type=click.FloatRange(min=0.0), default=None,
+@click.option("--time-limit", "time_limit_s", type=FiniteFloatRange(min=0.0, max=86400.0), default=None,
               help="auto's improvement budget in reference seconds (default: auto's own).")
 @click.option("--merge", "merge_files", multiple=True, type=click.Path(exists=True, dir_okay=False),
               help="Measure nothing: tabulate the runs of earlier --json outputs (repeatable; "

@@ -31,6 +31,16 @@ def reports_errors(function: Callable) -> Callable:
     return wrapper
 
 
+class FiniteFloatRange(click.FloatRange):
+    """A :class:`click.FloatRange` that also refuses NaN and infinities."""
+
+    def convert(self, value, param, ctx):
+        number = super().convert(value, param, ctx)
+        if not math.isfinite(number):
+            self.fail(f"{value!r} is not a finite number", param, ctx)
+        return number
+
+
 radius_option = click.option(
     "--radius", "rho_m", type=float, required=True, metavar="METRES",
     help="Minimum turn radius rho of the aircraft, in metres.")
@@ -122,6 +132,11 @@ mission_options = [
     click.option("--max-miss", "max_miss_m", type=float, default=5.0, show_default=True,
                  metavar="METRES", help="How close the predicted flight must pass each target "
                  "(the guidance design; with --simulate also the flight check's limit)."),
+    click.option("--wind-spread", "wind_spread_m_s", type=float, metavar="M/S",
+                 help="How far the real wind may be from --wind: the guidance design also "
+                      "holds every target within --max-miss in winds this much stronger and "
+                      "weaker and turned 20 deg each way (default a quarter of the wind, at "
+                      "least 1 m/s; 0: the forecast only)."),
     click.option("--tolerance", "tolerance_m", type=float, metavar="METRES",
                  help="--design geometry: largest distance between the exact path and the "
                       "waypoint polyline (default 2 % of rho; a quarter of it when the item "
@@ -134,7 +149,8 @@ mission_options = [
 
 def mission_settings(autopilot, altitude_m, airspeed_m_s, home_deg, home_amsl_m,
                      launch_bearing_deg, landing_bearing_deg, return_mode, design, max_miss_m,
-                     tolerance_m, max_items, vehicle=None, wind=None, **actions):
+                     tolerance_m, max_items, vehicle=None, wind=None, wind_spread_m_s=None,
+                     **actions):
     """The :class:`MissionSettings` of the :data:`mission_options` values (``vehicle``: the
     :class:`~dtsp_mission.autopilot.parameters.VehicleParameters` the mission is for;
     ``actions``: photo, roi, gimbal_pitch_deg, loiter_radius_m)."""
@@ -143,7 +159,8 @@ def mission_settings(autopilot, altitude_m, airspeed_m_s, home_deg, home_amsl_m,
     return MissionSettings(autopilot, altitude_m, airspeed_m_s, home_deg, home_amsl_m,
                            launch_bearing_deg, landing_bearing_deg, return_mode, tolerance_m,
                            max_items, design=design, max_miss_m=max_miss_m, vehicle=vehicle,
-                           wind=wind if wind is not None else CALM, **actions)
+                           wind=wind if wind is not None else CALM,
+                           wind_spread_m_s=wind_spread_m_s, **actions)
 
 
 def apply(options: list) -> Callable:

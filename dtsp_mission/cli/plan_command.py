@@ -11,7 +11,8 @@ import numpy as np
 
 from ..dubins.path import check_radius
 from ..export import exporter_for
-from ..files import write_atomic
+from ..errors import DtspError
+from ..files import check_replaceable, write_atomic
 from ..mission import Autopilot, MissionSettings
 from ..mission.build import targets_beyond
 from ..mission.sorties import sortie_path
@@ -26,7 +27,7 @@ from ..targets.geojson_file import read_geojson
 from . import console
 from .console import console_options, note, record, say
 from ..autopilot.navigation import CALM
-from .options import (LAT_LON, UserError, apply, link_options, mission_options,
+from .options import (FiniteFloatRange, LAT_LON, UserError, apply, link_options, mission_options,
                       mission_settings, progress_reporter, reports_errors, seed_option, simulation_options,
                       turn_radius_from, vehicle_options)
 
@@ -40,6 +41,10 @@ def _check_writable(paths) -> None:
         if resolved in seen:
             raise UserError(f"{path} is given twice as an output")
         seen.add(resolved)
+        try:
+            check_replaceable(path)
+        except DtspError as error:
+            raise UserError(str(error)) from None
         folder = resolved.parent
         if not folder.is_dir():
             raise UserError(f"{path}: the folder {folder} does not exist")
@@ -99,7 +104,7 @@ def _duration(seconds: float) -> str:
 @click.option("--region", default="bounding", show_default=True,
               help="Rectangle the bead tiling covers: 'bounding', 'min-area', or a sweep "
                    "heading in degrees counter-clockwise from east.")
-@click.option("--time-limit", "time_limit_s", type=click.FloatRange(min=0.0), default=None,
+@click.option("--time-limit", "time_limit_s", type=FiniteFloatRange(min=0.0, max=86400.0), default=None,
               metavar="SECONDS",
               help="Work budget of auto's improvement stage, in seconds of the reference machine "
                    "(a fixed amount of work: the same input, limit and --seed give the same tour "
@@ -118,7 +123,7 @@ def _duration(seconds: float) -> str:
               help="Upload the mission to this vehicle after writing the files "
                    "(udpout:HOST:PORT, ...); see `dtsp-mission upload`.")
 @apply(link_options)
-@click.option("--endurance", "endurance_min", type=click.FloatRange(min=0.0, min_open=True),
+@click.option("--endurance", "endurance_min", type=FiniteFloatRange(min=0.0, min_open=True),
               metavar="MINUTES", help="Longest flight the aircraft can make (take-off to the "
               "return, at --airspeed): a longer mission is split into sorties that each fit.")
 @click.option("--photo", is_flag=True, help="Take a picture at every target when it is overflown "
@@ -143,7 +148,7 @@ def _duration(seconds: float) -> str:
 @reports_errors
 def plan(targets_file, random_count, area_file, seed, origin, rho_m, airspeed_m_s, max_bank_deg,
          altitude_m, home_deg, home_amsl_m, launch_bearing_deg, landing_bearing_deg, autopilot,
-         return_mode, design, max_miss_m, tolerance_m, max_items, algorithm, region, time_limit_s,
+         return_mode, design, max_miss_m, wind_spread_m_s, tolerance_m, max_items, algorithm, region, time_limit_s,
          fallback, outputs, format_name,
          plot_file, connection, via, verify, signing_key_file, transfer_timeout_s, endurance_min,
          photo, roi, gimbal_pitch_deg, loiter_specs, loiter_radius_m, simulate, speedup,
@@ -200,7 +205,8 @@ def plan(targets_file, random_count, area_file, seed, origin, rho_m, airspeed_m_
                                     launch_bearing_deg, landing_bearing_deg, return_mode, design,
                                     max_miss_m, tolerance_m, max_items, designed_for,
                                     photo=photo, roi=roi, gimbal_pitch_deg=gimbal_pitch_deg,
-                                    loiter_radius_m=loiter_radius_m, wind=wind or CALM)
+                                    loiter_radius_m=loiter_radius_m, wind=wind or CALM,
+                                    wind_spread_m_s=wind_spread_m_s)
         settings.checked(rho)          # refused before planning, not after
         if autopilot == "px4" and any(writer.name == "waypoints" for _, writer in writers):
             note("a .waypoints file holds the home in its row 0, as QGroundControl, Mission "
@@ -333,11 +339,11 @@ def _report_sorties(result: PlanResult, max_miss_m: float) -> None:
         label = (lambda i: names[i] if names else f"target {i + 1}")
         time_text = (f", {_duration(summary['flight_time_s'])}" if "flight_time_s" in summary
                      else "")
-        beyond = targets_beyond(sortie.mission, max_miss_m)
+        beyond = targets_beyond(sortie.mission)
         say(f"  sortie {k + 1}: {len(sortie.targets)} targets ({label(first)} .. "
             f"{label(last)}), {summary['items']} items, "
             f"{summary['flight_length_m'] / 1e3:,.2f} km{time_text}"
-            + (f", {beyond} predicted beyond --max-miss" if beyond else ""))
+            + (f", {beyond} predicted beyond the design limit" if beyond else ""))
 
 
 #: A home farther than this from every target is worth a second look.
@@ -383,7 +389,8 @@ def _report_tour(result: PlanResult) -> None:
         say(f"  candidate {name}: {shown}")
     improvement = tour.report.get("improvement")
     if improvement:
-        gain = 1.0 - improvement["length_m"] / improvement["start_m"]
+        gain = (1.0 - improvement["length_m"] / improvement["start_m"]
+                if improvement["start_m"] > 0 else 0.0)
         spent = improvement["evaluations"] / max(improvement["budget"], 1)
         say(f"  improvement: {improvement['start_m']:,.1f} m -> {improvement['length_m']:,.1f} m "
                    f"({100 * gain:.1f} % shorter; {improvement['kicks']} perturbations, "

@@ -182,4 +182,8 @@ class QGCPlanExporter(Exporter):
                                      params[5], params[6], item["autoContinue"]))
         if not items:
             raise FileFormatError(f"{path}: the plan holds no mission items")
-        return VehicleMission(tuple(items), Home(*mission["plannedHomePosition"]), autopilot)
+        read = VehicleMission(tuple(items), Home(*mission["plannedHomePosition"]), autopilot)
+        problems = read.problems()
+        if problems:
+            raise FileFormatError(f"{path}: " + "; ".join(problems[:3]))
+        return read

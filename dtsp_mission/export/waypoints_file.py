@@ -81,5 +81,9 @@ class WaypointsExporter(Exporter):
         home = rows[0]
         items = tuple(MissionItem(int(r[3]), int(r[2]), tuple(r[4:8]), r[8], r[9], r[10], bool(r[11]))
                       for r in rows[1:])
-        return VehicleMission(items, Home(home[8], home[9], home[10]), Autopilot.ARDUPILOTMEGA,
+        read = VehicleMission(items, Home(home[8], home[9], home[10]), Autopilot.ARDUPILOTMEGA,
                               autopilot_stated=False)
+        problems = read.problems()
+        if problems:
+            raise FileFormatError(f"{path}: " + "; ".join(problems[:3]))
+        return read

@@ -48,6 +48,8 @@ by the model at its own step from the start; nothing is claimed that the model d
 from __future__ import annotations
 
 import math
+import os
+from concurrent.futures import ThreadPoolExecutor
 from dataclasses import dataclass, replace
 from typing import Callable
 
@@ -113,9 +115,15 @@ class GuidanceDesign:
     aim_m: np.ndarray               # (k, 2) where each waypoint is placed (local frame)
     target_of: np.ndarray           # target index (input order) of target waypoints, else -1
     predicted_miss_m: np.ndarray    # per target (input order): closest approach of the track
+                                    # in the forecast wind
     predicted_length_m: float       # predicted track length from take-off end to last target
     planned_length_m: float         # the exact path over the same span
     rounds: int                     # predicted flights the design took
+    #: per target, what the design is judged by (:func:`_judged`: the forecast's miss, or the
+    #: worst in the other design winds less the margin); None: the forecast's miss
+    judged_miss_m: np.ndarray | None = None
+    #: per target, the worst miss over the design winds; None: the forecast's miss
+    worst_miss_m: np.ndarray | None = None
 
     @property
     def shaping(self) -> int:
@@ -251,7 +259,7 @@ def _with_shaping(trial: _Trial, targets: list[int], lookback_m: float,
 LOCAL_BACK = 3
 LOCAL_AHEAD = 3
 LOCAL_MOVE = 2
-LOCAL_TRIALS = 100
+LOCAL_TRIALS = 40
 LOCAL_MIN_STEP_M = 0.25
 #: A target the pattern search leaves beyond can get up to this many other starts (seeded by
 #: its place in the mission; the first that holds it ends them), every movable waypoint
@@ -280,31 +288,67 @@ PREDICTION_MARGIN_M = 0.5
 #: with ArduPlane was measured at, which `fly` and `predict_flight` fly too), and holds the
 #: targets this much inside ``max_miss_m``.
 VERIFY_STEP_S = MODEL_STEP_S
+#: The local repair's pattern search judges its trials at this step (a change it keeps is
+#: judged again at ``VERIFY_STEP_S`` over the rest of the mission).
+SEARCH_STEP_S = PREDICTION_STEP_S
 VERIFY_MARGIN_M = 0.05
+
+
+_POOL: ThreadPoolExecutor | None = None
+
+
+def _each(function: Callable, items) -> list:
+    """``[function(item) for item in items]``, on every core (the compiled flights release
+    the GIL); in order, so the result does not depend on the machine."""
+    global _POOL
+    items = list(items)
+    if len(items) < 2 or (os.cpu_count() or 1) < 2:
+        return [function(item) for item in items]
+    if _POOL is None:
+        _POOL = ThreadPoolExecutor(max_workers=min(os.cpu_count() or 1, 8),
+                                   thread_name_prefix="design-flights")
+    return list(_POOL.map(function, items))
+
+
+def _judged(misses: list[np.ndarray], spread_margin_m: float) -> np.ndarray:
+    """Per target, the miss a design is judged by: its miss in the forecast wind (the first),
+    or its worst miss in the other winds less ``spread_margin_m`` if that is more (the model's
+    error margin covers the forecast; the other winds are the forecast's own error, held
+    within the limit the user asked for)."""
+    judged = np.array(misses[0], dtype=float)
+    if len(misses) > 1:
+        judged = np.maximum(judged, np.max(misses[1:], axis=0) - spread_margin_m)
+    return judged
 
 
 def _refine(aim: np.ndarray, target_of: list[int], items: list[LocalItem], seqs: list[int],
             home: np.ndarray, targets_m: np.ndarray, max_miss_m: float, airframe: Airframe,
-            heading: float, stored: Callable[[np.ndarray], np.ndarray], wind: Wind = CALM
+            heading: float, stored: Callable[[np.ndarray], np.ndarray],
+            winds: tuple[Wind, ...] = (CALM,), spread_margin_m: float = 0.0
             ) -> tuple[np.ndarray, np.ndarray, float, int]:
     """(aims, per-target miss, predicted length, whole flights) after up to
     :data:`REFINE_PASSES` passes of the local repair over the targets still beyond
-    ``max_miss_m``, in visit order, each from the design as repaired so far.  A change is kept
-    only if the mission flown on with it from its checkpoint costs less
-    (:meth:`_Trial.cost_of`); a moved waypoint is placed ``stored``.  Each pass ends with the whole mission flown afresh from the
-    start: the misses and length returned are those of the best such flight (a resumed flight
-    can differ from a fresh one by a few decimetres), so they are what the mission flies."""
+    ``max_miss_m``, in visit order, each from the design as repaired so far.  A target's miss
+    is :func:`_judged` over ``winds`` (each flown; the first is the forecast, whose flight
+    gives the length).  A change is kept only if the mission flown on with it from its checkpoints
+    costs less (:meth:`_Trial.cost_of`); a moved waypoint is placed ``stored``.  Each pass ends
+    with the whole mission flown afresh from the start: the misses and length returned are
+    those of the best such flights (a resumed flight can differ from a fresh one by a few
+    decimetres), so they are what the mission flies."""
     mission = MissionArrays.of(items)
     seq_set = set(seqs)
     last = len(items) - 2
     local_targets = targets_m - home
 
     def afresh(mission: MissionArrays):
-        flight = MissionFlight(mission, airframe, heading, 1, wind)
-        run = flight.run(VERIFY_STEP_S, last, marks=seq_set, points_m=local_targets,
-                         measure_from_seq=_AFTER_TAKEOFF, track=False, until_s=FLIGHT_LIMIT_S)
-        miss = run.closest_m
-        return run.checkpoints, miss, run.measured_length_m, _Trial.cost_of(miss, max_miss_m)
+        runs = _each(lambda wind: MissionFlight(mission, airframe, heading, 1, wind).run(
+                         VERIFY_STEP_S, last, marks=seq_set, points_m=local_targets,
+                         measure_from_seq=_AFTER_TAKEOFF, track=False, until_s=FLIGHT_LIMIT_S),
+                     winds)
+        miss = _judged([run.closest_m for run in runs], spread_margin_m)
+        marks = {seq: [run.checkpoints[seq] for run in runs] for seq in runs[0].checkpoints
+                 if all(seq in run.checkpoints for run in runs)}
+        return marks, miss, runs[0].measured_length_m, _Trial.cost_of(miss, max_miss_m)
 
     marks, miss, length, cost = afresh(mission)
     flights = 1
@@ -318,10 +362,8 @@ def _refine(aim: np.ndarray, target_of: list[int], items: list[LocalItem], seqs:
             if t < 0 or cost[t] <= 0.0:
                 continue
             begin, end = max(k - LOCAL_BACK, 0), min(k + LOCAL_AHEAD, len(seqs) - 1)
-            checkpoint = marks[seqs[begin]]
-            start = checkpoint.flight
+            checkpoints = marks[seqs[begin]]
             window = [target_of[j] for j in range(begin, end + 1) if target_of[j] >= 0]
-            fixed = checkpoint.closest_m[window]
             movable = list(range(max(k - LOCAL_MOVE, begin + 1 if begin > 0 else 0), k + 1))
             movable_index = np.array([seqs[j] for j in movable], dtype=np.int64)
 
@@ -329,10 +371,12 @@ def _refine(aim: np.ndarray, target_of: list[int], items: list[LocalItem], seqs:
                 return mission.with_positions(movable_index, points[movable] - home)
 
             def local_cost(points: np.ndarray) -> float:
-                run = start.copy(with_aims(points)).run(
+                changed = with_aims(points)
+                worst = _judged(_each(lambda checkpoint: checkpoint.flight.copy(changed).run(
                     VERIFY_STEP_S, seqs[end], track=False, points_m=local_targets[window],
-                    closest_m=fixed, measure_from_seq=_AFTER_TAKEOFF, until_s=FLIGHT_LIMIT_S)
-                return float(_Trial.cost_of(run.closest_m, max_miss_m).sum())
+                    closest_m=checkpoint.closest_m[window], measure_from_seq=_AFTER_TAKEOFF,
+                    until_s=FLIGHT_LIMIT_S).closest_m, checkpoints), spread_margin_m)
+                return float(_Trial.cost_of(worst, max_miss_m).sum())
 
             def descend(candidate: np.ndarray, current: float, step_m: float
                         ) -> tuple[np.ndarray, float]:
@@ -388,16 +432,20 @@ def _refine(aim: np.ndarray, target_of: list[int], items: list[LocalItem], seqs:
             if not np.any(candidate != aim):
                 continue
             changed = with_aims(candidate)
-            run = start.copy(changed).run(
-                VERIFY_STEP_S, last, track=False, marks={q for q in seq_set if q >= seqs[begin]},
-                points_m=local_targets, closest_m=checkpoint.closest_m,
-                measure_from_seq=_AFTER_TAKEOFF, until_s=FLIGHT_LIMIT_S)
+            later = {q for q in seq_set if q >= seqs[begin]}
+            runs = _each(lambda checkpoint: checkpoint.flight.copy(changed).run(
+                             VERIFY_STEP_S, last, track=False, marks=later, points_m=local_targets,
+                             closest_m=checkpoint.closest_m, measure_from_seq=_AFTER_TAKEOFF,
+                             until_s=FLIGHT_LIMIT_S), checkpoints)
             flights += 1
-            new_cost = _Trial.cost_of(run.closest_m, max_miss_m)
+            new_miss = _judged([run.closest_m for run in runs], spread_margin_m)
+            new_cost = _Trial.cost_of(new_miss, max_miss_m)
             if new_cost.sum() < cost.sum():
                 aim, mission = candidate, changed
-                miss, length, cost = run.closest_m, run.measured_length_m, new_cost
-                marks.update(run.checkpoints)
+                miss, length, cost = new_miss, runs[0].measured_length_m, new_cost
+                marks.update({seq: [run.checkpoints[seq] for run in runs]
+                              for seq in runs[0].checkpoints
+                              if all(seq in run.checkpoints for run in runs)})
         if cost.sum() >= before_pass:
             break
         marks, miss, length, cost = afresh(mission)
@@ -413,7 +461,8 @@ def design_waypoints(path: FlightPath, targets_m: np.ndarray, altitudes_m: np.nd
                      target_acceptance_m: float = 5.0, rounds: int | None = None,
                      progress: Callable[[int, int], None] | None = None,
                      as_stored: Callable[[np.ndarray], np.ndarray] | None = None,
-                     wind: Wind = CALM) -> GuidanceDesign:
+                     winds: tuple[Wind, ...] = (CALM,), spread_margin_m: float = 0.0
+                     ) -> GuidanceDesign:
     """The waypoints (``budget`` at most) that make the modelled autopilot pass every target
     of ``path`` within ``max_miss_m``, as far as ``rounds`` predicted flights of the repair and
     the local repair's passes allow.
@@ -464,7 +513,7 @@ def design_waypoints(path: FlightPath, targets_m: np.ndarray, altitudes_m: np.nd
                                    path.altitude_m(np.asarray(s_wp)), target_of,
                                    target_acceptance_m, loiters)
         track, reached, miss, predicted = _fly(items, airframe, heading, len(items) - 2,
-                                               targets_m - home, wind)
+                                               targets_m - home, winds[0])
         flown = track[:, 1:] + home
         after_takeoff = track[:, 0] >= reached.get(1, 0.0)
         start_s = reached.get(1, 0.0)
@@ -527,9 +576,18 @@ def design_waypoints(path: FlightPath, targets_m: np.ndarray, altitudes_m: np.nd
                                target_acceptance_m, loiters)
     verify_miss_m = max(max_miss_m - VERIFY_MARGIN_M, 0.5 * max_miss_m)
     aim, miss, length, flown = _refine(design.aim_m, best.target_of, items, seqs, home,
-                                       targets_m, verify_miss_m, airframe, heading, stored, wind)
+                                       targets_m, verify_miss_m, airframe, heading, stored, winds,
+                                       spread_margin_m)
     flights += flown
     if progress is not None:
         progress(min(flights, rounds), rounds)
-    return GuidanceDesign(design.s_m, aim, design.target_of, miss, length,
-                          design.planned_length_m, flights)
+    final, _ = _local_items(takeoff, takeoff_alt, head_items, aim - home,
+                            path.altitude_m(design.s_m), best.target_of, target_acceptance_m,
+                            loiters)
+    misses = [run.closest_m for run in _each(
+        lambda wind: MissionFlight(final, airframe, heading, 1, wind).run(
+            VERIFY_STEP_S, len(final) - 2, points_m=targets_m - home, track=False,
+            measure_from_seq=_AFTER_TAKEOFF, until_s=FLIGHT_LIMIT_S), winds)]
+    return GuidanceDesign(design.s_m, aim, design.target_of, misses[0], length,
+                          design.planned_length_m, flights + len(winds),
+                          _judged(misses, spread_margin_m), np.max(misses, axis=0))

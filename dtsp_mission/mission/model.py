@@ -59,6 +59,9 @@ class Home:
     altitude_amsl_m: float = 0.0
 
 
+_POSITIONLESS_FRAMES = {2}      # MAV_FRAME_MISSION: x and y are parameters, not a position
+
+
 @dataclass(frozen=True)
 class VehicleMission:
     """What a vehicle receives: the items, the home they are relative to, and the autopilot
@@ -73,6 +76,22 @@ class VehicleMission:
     home: Home
     autopilot: Autopilot
     autopilot_stated: bool = True
+
+    def problems(self) -> list[str]:
+        """What no autopilot would take from this mission: a home or an item position off
+        the globe (MAVLink's int32 degrees x 1e7 cannot even carry it) or not a number."""
+        found = []
+        if not (-90 <= self.home.latitude_deg <= 90 and -180 <= self.home.longitude_deg <= 180):
+            found.append(f"home ({self.home.latitude_deg:g}, {self.home.longitude_deg:g}) is not "
+                         "a latitude and longitude in degrees")
+        for number, item in enumerate(self.items, start=1):
+            if int(item.frame) in _POSITIONLESS_FRAMES:
+                continue
+            if not (-90 <= item.latitude_deg <= 90 and -180 <= item.longitude_deg <= 180):
+                found.append(f"item {number} (command {int(item.command)}) is at latitude "
+                             f"{item.latitude_deg:g}, longitude {item.longitude_deg:g}: not a "
+                             "position in degrees")
+        return found
 
 
 @dataclass(frozen=True)

@@ -109,7 +109,7 @@ def split_into_sorties(tour: Tour, frame: LocalFrame, targets: GeoTargets,
                 mission = build_mission(part, frame, targets.subset(chosen), settings)
                 flight_s = mission.summary.get("flight_time_s", 0.0)
                 fits = endurance_s is None or flight_s <= endurance_s
-                if replan is not None and fits and targets_beyond(mission, settings.max_miss_m):
+                if replan is not None and fits and targets_beyond(mission):
                     mission = _widened(mission, chosen, tour, targets, settings, endurance_s, replan)
                     flight_s = mission.summary.get("flight_time_s", 0.0)
                 if endurance_s is not None and flight_s > endurance_s:

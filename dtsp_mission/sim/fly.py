@@ -121,7 +121,7 @@ def fly_mission(mission: VehicleMission, targets: Targets, airframe: Airframe,
         # The altitude error where the track comes closest in 3-D: a target under the
         # climb-out is overflown low first and at altitude later.
         nearest = np.array([int(np.argmin(np.hypot(np.hypot(*(local_track - p).T), track[:, 2] - z)))
-                            for p, z in zip(local_targets, targets.altitudes_m)])
+                            for p, z in zip(local_targets, targets.altitudes_m)], dtype=np.int64)
         altitude_error = track[nearest, 2] - targets.altitudes_m
     else:
         miss = np.full(len(local_targets), np.inf)

@@ -75,7 +75,12 @@ def read_geojson(path: str | os.PathLike, text: str | None = None) -> GeoTargets
         geometry = feature.get("geometry") if isinstance(feature, dict) else None
         if not isinstance(geometry, dict):
             raise FileFormatError(f"{where}: has no geometry")
-        properties = feature.get("properties") or {}
+        properties = feature.get("properties")
+        if properties is None:
+            properties = {}
+        if not isinstance(properties, dict):
+            raise FileFormatError(f"{where}: 'properties' must be an object (name, alt, photo, "
+                                  f"...) or null, got {properties!r}")
         kind = geometry.get("type")
         if kind == "Polygon":
             if area is not None:
@@ -91,10 +96,19 @@ def read_geojson(path: str | os.PathLike, text: str | None = None) -> GeoTargets
                     or not all(isinstance(c, (int, float)) for c in point[:2])):
                 raise FileFormatError(f"{where}: coordinates must be [longitude, latitude], "
                                       f"got {point!r}")
+            if len(point) > 2:
+                raise FileFormatError(
+                    f"{where}: a third coordinate ({point[2]!r}) is an altitude of unknown "
+                    "reference (GeoJSON's is above the ellipsoid); give [longitude, latitude] "
+                    "and the altitude above home as the 'alt' property")
             longitudes.append(float(point[0]))
             latitudes.append(float(point[1]))
             names.append(str(properties.get("name", "")))
             altitude = properties.get("alt")
+            if altitude is not None and (isinstance(altitude, bool)
+                                         or not isinstance(altitude, (int, float))):
+                raise FileFormatError(f"{where}: 'alt' must be a number of metres above home, "
+                                      f"got {altitude!r}")
             altitudes.append(np.nan if altitude is None else altitude)
             for key, spellings in COLUMNS.items():
                 given = next((properties[p] for p in spellings if p in properties), None)

@@ -139,15 +139,17 @@ def test_the_repair_keeps_only_what_the_model_flew_better(monkeypatch):
     settings = MissionSettings(design="guidance", airspeed_m_s=22.0, altitude_m=120.0)
 
     def excess(mission):
-        miss = np.array(mission.summary["predicted_miss_m"])
-        return float(np.maximum(miss - settings.max_miss_m, 0.0).sum()), int((miss > 5.0).sum())
+        miss = np.array(mission.summary["judged_miss_m"])
+        limit = settings.design_limit_m
+        return float(np.maximum(miss - limit, 0.0).sum()), int((miss > limit).sum())
     repaired = build_mission(tour, frame, targets, settings)
     monkeypatch.setattr(guidance, "ROUNDS", 1)
     monkeypatch.setattr(guidance, "REFINE_PASSES", 0)
     first = build_mission(tour, frame, targets, settings)
     assert excess(repaired)[0] < excess(first)[0] and excess(repaired)[1] < excess(first)[1]
     assert 2 < repaired.summary["design_rounds"]
-    assert first.summary["design_rounds"] == 2       # one predicted flight, then the verifying one
+    # one predicted flight, the verifying one, then the design flown in each design wind
+    assert first.summary["design_rounds"] == 2 + len(settings.design_winds())
 
 
 def test_a_flight_copied_midway_goes_on_exactly_as_the_original():
@@ -190,10 +192,11 @@ def test_the_local_repair_holds_more_and_reports_what_the_mission_flies(monkeypa
     repaired = build_mission(tour, frame, targets, settings)
     monkeypatch.setattr(guidance, "REFINE_PASSES", 0)
     unrepaired = build_mission(tour, frame, targets, settings)
-    held = np.array(repaired.summary["predicted_miss_m"])
-    before = np.array(unrepaired.summary["predicted_miss_m"])
-    assert (before > 5.0).sum() > 0
-    assert (held > 5.0).sum() < (before > 5.0).sum()
+    limit = settings.design_limit_m
+    held = np.array(repaired.summary["predicted_miss_m"])          # in the forecast (calm) air
+    before = np.array(unrepaired.summary["judged_miss_m"])
+    assert (before > limit).sum() > 0
+    assert (np.array(repaired.summary["judged_miss_m"]) > limit).sum() < (before > limit).sum()
     flight = predict_flight(repaired.for_vehicle(), Airframe.from_parameters(airspeed_m_s=22.0),
                             guidance.VERIFY_STEP_S)
     after = flight.track[:, 0] >= flight.reached[1]
@@ -203,39 +206,47 @@ def test_the_local_repair_holds_more_and_reports_what_the_mission_flies(monkeypa
 
 
 @pytest.mark.heavy(seconds=16)
-def test_a_flight_that_strays_from_its_plan_is_planned_again_with_wider_turns():
-    """At rho 80 m this site's predicted flight is more than 5 % longer than the planned one
-    (the autopilot swings wide of turns it cannot hold and loops back to the targets after
-    them); the turn margin plans it again wider, and the mission it keeps follows its plan
-    within FOLLOWS_PLAN_WITHIN and still holds every target."""
-    from dtsp_mission.mission.build import FOLLOWS_PLAN_WITHIN, length_excess, with_turn_margin
-    tour, frame, targets = sparse_site(40, seed=1, side=350.0 * np.sqrt(40))
-    settings = MissionSettings(altitude_m=120.0, airspeed_m_s=22.0, design="guidance")
-    mission = build_mission(tour, frame, targets, settings)
-    assert max(mission.summary["predicted_miss_m"]) <= 5.0
-    assert length_excess(mission) > FOLLOWS_PLAN_WITHIN
-    widened = with_turn_margin(mission, lambda rho: get_planner("auto").plan(
-        targets.in_frame(frame).positions_m, rho), targets, settings)
-    assert widened.rho_m > mission.rho_m
-    assert length_excess(widened) <= FOLLOWS_PLAN_WITHIN
-    assert max(widened.summary["predicted_miss_m"]) <= 5.0
+def test_the_turn_margin_keeps_a_design_that_holds_and_otherwise_ranks_by_the_flight():
+    """Flight time is what the operator pays for: a design that holds every target is kept
+    as it is (no other radius is even planned), however far its flight strays from the plan;
+    one that does not is replaced only by a design holding more targets, or as many with a
+    shorter predicted flight."""
+    from dtsp_mission.mission.build import targets_beyond, with_turn_margin
+    tour, frame, targets = _fence(80.0)
+    planned = []
+
+    def replan(rho):
+        planned.append(rho)
+        return get_planner("auto").plan(targets.in_frame(frame).positions_m, rho)
+
+    def key(mission):
+        return targets_beyond(mission), mission.summary["predicted_flight_m"]
+    loose = MissionSettings(altitude_m=120.0, airspeed_m_s=22.0, design="guidance", max_miss_m=60.0)
+    mission = build_mission(tour, frame, targets, loose)
+    assert targets_beyond(mission) == 0
+    assert with_turn_margin(mission, replan, targets, loose) is mission and planned == []
+    strict = MissionSettings(altitude_m=120.0, airspeed_m_s=22.0, design="guidance")
+    mission = build_mission(tour, frame, targets, strict)
+    assert targets_beyond(mission) > 0
+    chosen = with_turn_margin(mission, replan, targets, strict)
+    assert planned and planned[0] == pytest.approx(1.3 * mission.rho_m)
+    assert key(chosen) <= key(mission)
+    assert chosen is mission or chosen.rho_m in [pytest.approx(r) for r in planned]
 
 
 @pytest.mark.heavy(seconds=29)
 def test_the_local_repair_s_other_starts_hold_what_small_steps_cannot(monkeypatch):
-    """After four repair rounds on the fence, the local repair's pattern search (from the
-    repaired aims and from the targets) leaves a post 12.9 m off; given 100
-    seeded random starts (off by default: they double the design time) it holds every post,
-    and the same input gives the same mission.  (The starts are a heuristic, not a guarantee:
-    after two rounds the same fence is held without them and keeps one post at 6.1 m with
-    them -- the repair changes one target at a time.)"""
+    """After four repair rounds on the fence (forecast wind only), the local repair's pattern
+    search (from the repaired aims and from the targets) leaves a post beyond the design
+    limit; given 100 seeded random starts (off by default) it holds every post, and the same
+    input gives the same mission.  (The starts are a heuristic, not a guarantee: after six or
+    eight rounds they leave two posts beyond where the search alone leaves one or none.)"""
     import dtsp_mission.mission.guidance as guidance
+    from dtsp_mission.mission.build import targets_beyond as beyond
     tour, frame, targets = _fence(80.0)
-    settings = MissionSettings(design="guidance", airspeed_m_s=22.0, altitude_m=120.0)
+    settings = MissionSettings(design="guidance", airspeed_m_s=22.0, altitude_m=120.0,
+                               wind_spread_m_s=0.0)
     monkeypatch.setattr(guidance, "ROUNDS", 4)
-
-    def beyond(mission):
-        return int((np.array(mission.summary["predicted_miss_m"]) > 5.0).sum())
     alone = build_mission(tour, frame, targets, settings)
     assert beyond(alone) > 0
     monkeypatch.setattr(guidance, "LOCAL_STARTS", 100)
@@ -255,24 +266,24 @@ def _clustered(count: int, seed: int):
     return local_targets(points).to_geodetic(LocalFrame(*CENTRE))
 
 
-@pytest.mark.heavy(seconds=105)
+@pytest.mark.heavy(seconds=60)
 def test_the_local_repair_starts_again_from_the_targets_where_corrections_piled_up(monkeypatch):
-    """On a clustered site (80 targets, rho 104 m) the pattern search from the repaired aims
-    leaves a target beyond 5 m (7.3 m): the corrections of neighbouring waypoints, each moved
-    to pass its own target, hold each other where no small step helps.  Searched again from
-    those waypoints put back on their targets, every target is held."""
+    """On a clustered site (80 targets, seed 2, rho 80 m; forecast wind only) the pattern
+    search from the repaired aims leaves a target beyond the design limit: the corrections of
+    neighbouring waypoints, each moved to pass its own target, hold each other where no small
+    step helps.  Searched again from those waypoints put back on their targets, every target
+    is held.  (A heuristic: over seeds 0-3 at rho 80 and 104 it leaves 14 targets beyond with
+    the second search and 14 without.)"""
     import dtsp_mission.mission.guidance as guidance
     from dtsp_mission.api import plan_tour
-    targets = _clustered(80, 0)
-    tour, frame = plan_tour(targets, 104.0)
+    from dtsp_mission.mission.build import targets_beyond
+    targets = _clustered(80, 2)
+    tour, frame = plan_tour(targets, 80.0)
     settings = MissionSettings(design="guidance", airspeed_m_s=22.0, altitude_m=120.0,
-                               home_deg=CENTRE)
-
-    def beyond(mission):
-        return int((np.array(mission.summary["predicted_miss_m"]) > 5.0).sum())
+                               home_deg=CENTRE, wind_spread_m_s=0.0)
     monkeypatch.setattr(guidance, "LOCAL_RESET", False)
     stuck = build_mission(tour, frame, targets, settings)
     monkeypatch.setattr(guidance, "LOCAL_RESET", True)
     held = build_mission(tour, frame, targets, settings)
-    assert beyond(stuck) > 0 and beyond(held) == 0
+    assert targets_beyond(stuck) > 0 and targets_beyond(held) == 0
     assert len(held.items) == len(stuck.items)          # the same waypoints, placed otherwise

@@ -1,0 +1,136 @@
+"""The rows of the hostile-input report (issue 31) that are fixed, as regression tests: each
+command as a user typed it, in a real process under a timeout, must end with a one-line
+message and exit 2 (or a correct result) -- never a traceback, never a hang, never a file
+written over something that is not a regular file."""
+
+from __future__ import annotations
+
+import json
+import os
+import subprocess
+import sys
+from pathlib import Path
+
+import pytest
+
+ROOT = Path(__file__).resolve().parents[1]
+SITE = ROOT / "examples" / "site-inspection.csv"
+
+
+def run(*arguments, cwd=None):
+    return subprocess.run([sys.executable, "-m", "dtsp_mission.cli", *map(str, arguments)],
+                          capture_output=True, text=True, timeout=120, cwd=cwd)
+
+
+def refused(result, *words):
+    assert result.returncode == 2, (result.returncode, result.stderr[-2000:])
+    assert "Traceback" not in result.stderr
+    for word in words:
+        assert word in result.stderr, result.stderr
+
+
+def test_targets_that_merge_into_one_give_a_result_not_a_traceback(tmp_path):
+    (tmp_path / "n3.csv").write_text("x,y\n0,0\n0.000000001,0\n0,0.000000001\n")
+    result = run("plan", tmp_path / "n3.csv", "--radius", 80, "--origin", "46.8,6.95",
+                 "-o", tmp_path / "n3.json")
+    assert "Traceback" not in result.stderr
+    assert result.returncode in (0, 2), result.stderr
+
+
+@pytest.mark.parametrize("properties,words", [('"camera"', ["'properties' must be an object"]),
+                                              ('{"alt": true}', ["'alt' must be a number"])])
+def test_geojson_properties_of_the_wrong_kind_are_named(tmp_path, properties, words):
+    features = [{"type": "Feature", "properties": "PROPS",
+                 "geometry": {"type": "Point", "coordinates": [6.95, 46.8]}},
+                {"type": "Feature", "properties": {"alt": 100},
+                 "geometry": {"type": "Point", "coordinates": [6.96, 46.81]}}]
+    text = json.dumps({"type": "FeatureCollection", "features": features})
+    (tmp_path / "t.geojson").write_text(text.replace('"PROPS"', properties))
+    refused(run("plan", tmp_path / "t.geojson", "--radius", 80, "--time-limit", 1,
+                "-o", tmp_path / "t.plan"), *words)
+    assert not (tmp_path / "t.plan").exists()
+
+
+def test_a_third_geojson_coordinate_is_not_dropped_in_silence(tmp_path):
+    features = [{"type": "Feature", "properties": {},
+                 "geometry": {"type": "Point", "coordinates": [6.95 + k / 100, 46.8, 500]}}
+                for k in range(3)]
+    (tmp_path / "t.geojson").write_text(json.dumps({"type": "FeatureCollection",
+                                                    "features": features}))
+    refused(run("plan", tmp_path / "t.geojson", "--radius", 80, "-o", tmp_path / "t.json"),
+            "third coordinate")
+
+
+@pytest.mark.parametrize("line,words", [
+    ("ROLL_LIMIT_DEG 0", ["ROLL_LIMIT_DEG 0 is out of its range"]),
+    ("AIRSPEED_CRUISE 0", ["AIRSPEED_CRUISE 0 is out of its range"]),
+    ("NAVL1_PERIOD nan", ["NAVL1_PERIOD nan is out of its range"]),
+    ("NAVL1_PERIOD -5", ["NAVL1_PERIOD -5 is out of its range"]),
+    ("NAVL1_PERIODX 12", ["did you mean NAVL1_PERIOD"]),
+    ("ROLL_LIMIT_DEG 12", ["cannot turn at 80 m", "no tighter than"]),
+])
+def test_vehicle_parameters_are_checked_before_planning(tmp_path, line, words):
+    (tmp_path / "v.parm").write_text(line + "\n")
+    refused(run("plan", SITE, "--radius", 80, "--time-limit", 1, "--vehicle-params",
+                tmp_path / "v.parm", "-o", tmp_path / "v.json"), *words)
+    assert not (tmp_path / "v.json").exists()
+
+
+@pytest.mark.parametrize("value", ["nan", "inf", "1e300"])
+def test_time_limits_are_finite(tmp_path, value):
+    refused(run("plan", SITE, "--radius", 80, "--time-limit", value, "-o", tmp_path / "t.json"),
+            "--time-limit")
+
+
+def test_a_radius_beyond_reason_is_refused_before_planning(tmp_path):
+    refused(run("plan", SITE, "--radius", "1e9", "-o", tmp_path / "t.json"), "beyond reason")
+
+
+@pytest.mark.skipif(not hasattr(os, "mkfifo"), reason="needs FIFOs")
+def test_an_output_never_replaces_a_fifo(tmp_path):
+    fifo = tmp_path / "out.plan"
+    os.mkfifo(fifo)
+    refused(run("plan", SITE, "--radius", 80, "--time-limit", 1, "-o", fifo), "is a FIFO")
+    assert fifo.is_fifo()
+
+
+def _plan_variant(tmp_path: Path, name: str, change) -> Path:
+    """A small valid .plan (6 targets, geometry design), changed by ``change(document)``."""
+    source = tmp_path / "base.plan"
+    if not source.exists():
+        (tmp_path / "t.csv").write_text("lat,lon\n" + "".join(
+            f"{46.80 + 0.004 * (k % 3)},{6.95 + 0.005 * k}\n" for k in range(6)))
+        result = run("plan", tmp_path / "t.csv", "--radius", 80, "--time-limit", 1, "--design",
+                     "geometry", "-o", source)
+        assert result.returncode == 0, result.stderr
+    document = json.loads(source.read_text())
+    change(document)
+    out = tmp_path / name
+    out.write_text(json.dumps(document))
+    return out
+
+
+def test_a_plan_position_off_the_globe_is_refused_when_read(tmp_path):
+    def far(document):
+        document["mission"]["items"][2]["params"][4] = 999
+    refused(run("fly", _plan_variant(tmp_path, "far.plan", far), "--speedup", 0),
+            "latitude 999", "not a position in degrees")
+
+
+def test_fly_of_a_plan_without_waypoints_reports_instead_of_crashing(tmp_path):
+    def bare(document):
+        items = document["mission"]["items"]
+        document["mission"]["items"] = [items[0], items[-1]]
+    result = run("fly", _plan_variant(tmp_path, "bare.plan", bare), "--speedup", 0)
+    assert "Traceback" not in result.stderr
+    assert result.returncode == 0, result.stderr
+
+
+@pytest.mark.parametrize("field,value,answer", [("command", 9999, "MAV_MISSION_UNSUPPORTED"),
+                                                ("frame", 1, "MAV_MISSION_UNSUPPORTED_FRAME")])
+def test_the_simulated_vehicle_refuses_what_ardupilot_refuses(tmp_path, field, value, answer):
+    def odd(document):
+        document["mission"]["items"][2][field] = value
+    refused_flight = run("fly", _plan_variant(tmp_path, "odd.plan", odd), "--speedup", 0)
+    assert refused_flight.returncode != 0 and "Traceback" not in refused_flight.stderr
+    assert answer in refused_flight.stderr, refused_flight.stderr
