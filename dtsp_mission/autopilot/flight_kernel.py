@@ -27,18 +27,18 @@ import math
 import numba
 import numpy as np
 
+from ..vehicle import STANDARD_GRAVITY_M_S2
+from .commands import Command
+
 _JIT = dict(cache=True, error_model="numpy", nogil=True)
 
-G = 9.80665
+G = STANDARD_GRAVITY_M_S2
 
-# MAV_CMD values the flight model acts on (the same as .commands.Command).
-NAV_WAYPOINT = 16
-NAV_LOITER_TURNS = 18
-NAV_LOITER_TIME = 19
-NAV_RETURN_TO_LAUNCH = 20
-NAV_LAND = 21
-NAV_TAKEOFF = 22
-DO_CHANGE_SPEED = 178
+# The MAV_CMD values the flight model acts on, as plain ints (compile-time constants).
+(NAV_WAYPOINT, NAV_LOITER_TURNS, NAV_LOITER_TIME, NAV_RETURN_TO_LAUNCH, NAV_LAND, NAV_TAKEOFF,
+ DO_CHANGE_SPEED) = (int(c) for c in (
+    Command.NAV_WAYPOINT, Command.NAV_LOITER_TURNS, Command.NAV_LOITER_TIME,
+    Command.NAV_RETURN_TO_LAUNCH, Command.NAV_LAND, Command.NAV_TAKEOFF, Command.DO_CHANGE_SPEED))
 
 # -- the state vector --------------------------------------------------------------------------
 S_X, S_Y, S_ALT, S_HEADING, S_AIRSPEED, S_BANK, S_BANK_RATE, S_TIME = range(8)

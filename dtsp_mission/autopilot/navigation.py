@@ -23,7 +23,7 @@ from . import flight_kernel as K
 from .commands import Command, Frame
 from .parameters import ARDUPLANE_DEFAULTS, VehicleParameters
 
-G = 9.80665
+G = K.G
 #: ArduPlane defaults: NAVL1_DAMPING, WP_RADIUS (m).
 L1_DAMPING = 0.75
 WP_RADIUS_M = 90.0
