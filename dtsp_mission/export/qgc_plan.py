@@ -182,7 +182,13 @@ class QGCPlanExporter(Exporter):
                                      params[5], params[6], item["autoContinue"]))
         if not items:
             raise FileFormatError(f"{path}: the plan holds no mission items")
-        read = VehicleMission(tuple(items), Home(*mission["plannedHomePosition"]), autopilot)
+        wind = (data.get("dtspMission") or {}).get("designWind") if isinstance(
+            data.get("dtspMission"), dict) else None
+        design_wind = None
+        if isinstance(wind, dict) and all(_is_number(wind.get(k)) for k in ("speed_m_s", "from_deg")):
+            design_wind = (float(wind["speed_m_s"]), float(wind["from_deg"]))
+        read = VehicleMission(tuple(items), Home(*mission["plannedHomePosition"]), autopilot,
+                              design_wind=design_wind)
         problems = read.problems()
         if problems:
             raise FileFormatError(f"{path}: " + "; ".join(problems[:3]))

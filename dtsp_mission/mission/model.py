@@ -76,6 +76,8 @@ class VehicleMission:
     home: Home
     autopilot: Autopilot
     autopilot_stated: bool = True
+    #: the wind the mission was designed for: (m/s, degrees true it comes from); None: unknown
+    design_wind: tuple[float, float] | None = None
 
     def problems(self) -> list[str]:
         """What no autopilot would take from this mission: a home or an item position off
@@ -178,7 +180,10 @@ class Mission:
         return numbers
 
     def for_vehicle(self) -> VehicleMission:
-        return VehicleMission(self.items, self.home, self.autopilot)
+        wind = self.summary.get("design_wind")
+        return VehicleMission(self.items, self.home, self.autopilot,
+                              design_wind=None if wind is None else (wind["speed_m_s"],
+                                                                     wind["from_deg"]))
 
     def vehicle_item_count(self) -> int:
         """Mission slots on the vehicle: the items plus ArduPilot's home at seq 0."""

@@ -25,6 +25,7 @@ import time
 from dataclasses import dataclass, field
 
 import numpy as np
+from pymavlink.dialects.v20 import ardupilotmega
 from pymavlink.dialects.v20 import common as mavlink2
 
 from ..autopilot.navigation import (CALM, MODEL_STEP_S, Airframe, LocalItem, MissionFlight, Wind,
@@ -262,6 +263,9 @@ class SimulatedVehicle:
                 self._encoder.srcSystem = message.get_srcSystem()
                 self._encoder.srcComponent = message.get_srcComponent()
                 self._encoder.send(message)
+                if (message.get_type() == "HEARTBEAT"
+                        and self.settings.autopilot == Autopilot.ARDUPILOTMEGA):
+                    self._publish_wind()        # ArduPilot streams its wind estimate
 
     def _as_fixed_wing(self, heartbeat) -> None:
         flying = self.flight is not None and not self.finished.is_set()
@@ -419,6 +423,14 @@ class SimulatedVehicle:
                     - (time.monotonic() - paced_from[0])
                 if ahead > 0.002:
                     time.sleep(ahead)
+
+    def _publish_wind(self) -> None:
+        """ArduPilot's WIND message (its estimate; here the wind it flies in); called with the
+        link lock held."""
+        wind = self.settings.wind
+        self._encoder.srcSystem, self._encoder.srcComponent = 1, 1
+        self._encoder.send(ardupilotmega.MAVLink_wind_message(float(wind.from_deg),
+                                                              float(wind.speed_m_s), 0.0))
 
     def _publish(self, state, ground_velocity_m_s: tuple[float, float]) -> None:
         """GLOBAL_POSITION_INT, from the vehicle's own encoder: in order with

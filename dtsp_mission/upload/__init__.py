@@ -62,6 +62,15 @@ def _autopilot_name(value: int) -> str:
     return _AUTOPILOT_NAMES.get(value, f"MAV_AUTOPILOT {value}")
 
 
+#: The vehicle's wind estimate is worth a warning when it differs from the design wind by more
+#: than this much speed or direction.
+WIND_WARNING_M_S = 2.0
+WIND_WARNING_DEG = 30.0
+#: How long an upload of a mission designed for a wind listens for ArduPilot's wind estimate
+#: (streamed at 1 Hz or more on a ground station's link).
+WIND_WAIT_S = 1.5
+
+
 def vehicle_warnings(mission: VehicleMission, info: VehicleInfo,
                      designed_for: VehicleParameters | None = None) -> list[str]:
     """What to tell before an upload: raises :class:`LinkError` if the vehicle runs another
@@ -82,6 +91,13 @@ def vehicle_warnings(mission: VehicleMission, info: VehicleInfo,
         for name, ours, theirs in expected.differing(on_vehicle):
             warnings.append(f"the vehicle's {name} is {theirs:g}, the mission was designed for "
                             f"{ours:g}: it will fly differently than predicted")
+    if info.wind is not None and mission.design_wind is not None:
+        (speed, towards), (ours, our_dir) = info.wind, mission.design_wind
+        turned = abs((towards - our_dir + 180.0) % 360.0 - 180.0)
+        if abs(speed - ours) > WIND_WARNING_M_S or (max(speed, ours) >= 1.0 and turned > WIND_WARNING_DEG):
+            warnings.append(f"the vehicle estimates a wind of {speed:.1f} m/s from {towards:.0f} deg; "
+                            f"the mission was designed for {ours:g} m/s from {our_dir:g} deg: it "
+                            "will fly differently than predicted (plan again with --wind)")
     if info.home_deg is not None:
         from pyproj import Geod
         _, _, distance = Geod(ellps="WGS84").inv(mission.home.longitude_deg, mission.home.latitude_deg,
@@ -124,7 +140,8 @@ def upload_mission(mission: VehicleMission, connection: str, via: str = "pymavli
     started = time.perf_counter()
     with uploader_class(connection, signing_key=signing_key, **options) as uploader:
         names = NAMES if mission.autopilot == Autopilot.ARDUPILOTMEGA else ()
-        info = uploader.vehicle_info(names)
+        info = uploader.vehicle_info(names, WIND_WAIT_S if mission.design_wind is not None
+                                     and mission.autopilot == Autopilot.ARDUPILOTMEGA else 0.0)
         if not mission.autopilot_stated and info.autopilot in _AUTOPILOT_NAMES:
             # A .waypoints file does not say its autopilot: it is meant for this vehicle's.
             mission = replace(mission, autopilot=Autopilot(info.autopilot), autopilot_stated=True)

@@ -41,6 +41,9 @@ class VehicleInfo:
     home_deg: tuple[float, float] | None = None    # HOME_POSITION latitude, longitude
     parameters: dict[str, float] = field(default_factory=dict)
     checked: bool = False                          # whether the uploader could ask at all
+    #: the vehicle's own wind estimate (ArduPilot's WIND: m/s, degrees it comes from), if it
+    #: sent one while asked the rest
+    wind: tuple[float, float] | None = None
 
 
 class Uploader:
@@ -74,9 +77,11 @@ class Uploader:
     def close(self) -> None:
         raise NotImplementedError
 
-    def vehicle_info(self, parameter_names: tuple[str, ...] = ()) -> VehicleInfo:
+    def vehicle_info(self, parameter_names: tuple[str, ...] = (),
+                     wind_wait_s: float = 0.0) -> VehicleInfo:
         """The vehicle's autopilot, home and the named parameters, as far as this uploader
-        can ask (the default: nothing is known)."""
+        can ask, and its wind estimate if it sends one within ``wind_wait_s`` (the default:
+        nothing is known)."""
         return VehicleInfo()
 
     def upload(self, items: list[WireItem], progress: Progress | None = None) -> None:

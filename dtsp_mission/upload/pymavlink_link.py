@@ -168,21 +168,25 @@ class PymavlinkUploader(Uploader):
 
     # -- what the vehicle is ---------------------------------------------------------------------
 
-    def vehicle_info(self, parameter_names: tuple[str, ...] = ()) -> VehicleInfo:
+    def vehicle_info(self, parameter_names: tuple[str, ...] = (),
+                     wind_wait_s: float = 0.0) -> VehicleInfo:
         """Its autopilot (heartbeat), home (HOME_POSITION, asked with MAV_CMD_REQUEST_MESSAGE)
         and the named parameters (PARAM_REQUEST_READ): what is still missing is asked again
         every 0.1 s (or the measured retry timeout, once known; longer after a round without
         any answer), for :data:`VEHICLE_INFO_S` at most (a vehicle stays
         silent for a parameter it does not have).  The first answer measures the link's round
-        trip for the transfers that follow."""
+        trip for the transfers that follow.  ArduPilot's WIND (its wind estimate, streamed,
+        never asked for) is kept if it comes meanwhile, or within ``wind_wait_s``."""
         system, component = self._target
         timer = self._timer = getattr(self, "_timer", None) or RetransmitTimer()
         values: dict[str, float] = {}
-        home = None
+        home = wind = None
         started = time.monotonic()
         deadline = started + VEHICLE_INFO_S
         interval, rounds = 0.1, 0
-        while (missing := [n for n in parameter_names if n not in values]) or home is None:
+        wind_until = started + min(wind_wait_s, VEHICLE_INFO_S)
+        while ((missing := [n for n in parameter_names if n not in values]) or home is None
+               or (wind is None and time.monotonic() < wind_until)):
             now = time.monotonic()
             if now >= deadline:
                 break
@@ -195,8 +199,11 @@ class PymavlinkUploader(Uploader):
             until = min(deadline, now + interval)
             answered = False
             while (remaining := until - time.monotonic()) > 0:
-                message = self._receive({"PARAM_VALUE", "HOME_POSITION"}, remaining)
+                message = self._receive({"PARAM_VALUE", "HOME_POSITION", "WIND"}, remaining)
                 if message is None:
+                    continue
+                if message.get_type() == "WIND":          # streamed, never asked for
+                    wind = (float(message.speed), float(message.direction) % 360.0)
                     continue
                 answered = True
                 if rounds == 1 and timer.srtt_s is None:
@@ -205,11 +212,12 @@ class PymavlinkUploader(Uploader):
                     home = (message.latitude / 1e7, message.longitude / 1e7)
                 elif (name := parameter_name(message.param_id)) in parameter_names:
                     values[name] = float(message.param_value)
-                if home is not None and len(values) == len(parameter_names):
+                if home is not None and len(values) == len(parameter_names) and (
+                        wind is not None or time.monotonic() >= wind_until):
                     break
             interval = (min(1.0, interval * 2) if not answered else
                         max(0.05, 2 * timer.timeout_s) if timer.srtt_s is not None else 0.1)
-        return VehicleInfo(self._autopilot, home, values, True)
+        return VehicleInfo(self._autopilot, home, values, True, wind)
 
     # -- the mission protocol ------------------------------------------------------------------
 

@@ -71,3 +71,40 @@ def test_a_px4_plan_is_refused_by_an_ardupilot_vehicle(start_vehicle):
     assert "made for PX4, but the vehicle runs ArduPilot" in str(caught.value)
     assert "--autopilot ardupilot" in str(caught.value)
     assert vehicle.uploads == 0
+
+
+def test_a_vehicle_whose_wind_estimate_differs_from_the_design_wind_is_warned_about(mission, start_vehicle):
+    """ArduPilot streams its wind estimate (WIND); an upload of a mission designed for another
+    wind says so, naming both, and says nothing when they agree within 2 m/s and 30 deg."""
+    from dtsp_mission.autopilot.navigation import Wind
+    vehicle = start_vehicle(mission, wind=Wind(8.0, 40.0))
+    calm = replace(mission, design_wind=(0.0, 0.0))
+    report = upload_mission(calm, f"udpout:127.0.0.1:{vehicle.port}")
+    assert report.verified
+    assert [w for w in report.warnings if "wind" in w] == [
+        "the vehicle estimates a wind of 8.0 m/s from 40 deg; the mission was designed for "
+        "0 m/s from 0 deg: it will fly differently than predicted (plan again with --wind)"]
+    close = replace(mission, design_wind=(7.0, 55.0))
+    assert not [w for w in upload_mission(close, f"udpout:127.0.0.1:{vehicle.port}").warnings
+                if "wind" in w]
+
+
+def test_the_plan_file_carries_the_design_wind(tmp_path):
+    """The .plan records the wind a guidance design was made for, and reading it back gives
+    the uploader that wind to compare with the vehicle's."""
+    import numpy as np
+    from dtsp_mission.api import plan_tour
+    from dtsp_mission.autopilot.navigation import Wind
+    from dtsp_mission.export import exporter_for, read_mission
+    from dtsp_mission.frame import LocalFrame
+    from dtsp_mission.mission import MissionSettings, build_mission
+    from dtsp_mission.targets.model import local_targets
+    points = np.random.default_rng(4).uniform(-800, 800, (8, 2))
+    targets = local_targets(points).to_geodetic(LocalFrame(46.8, 6.95))
+    tour, frame = plan_tour(targets, 80.0)
+    designed = build_mission(tour, frame, targets, MissionSettings(
+        design="guidance", airspeed_m_s=22.0, wind=Wind(6.0, 250.0), wind_spread_m_s=0.0))
+    path = tmp_path / "w.plan"
+    path.write_text(exporter_for(path).render(designed))
+    assert read_mission(path).design_wind == (6.0, 250.0)
+    assert designed.for_vehicle().design_wind == (6.0, 250.0)
