@@ -134,3 +134,17 @@ def test_the_simulated_vehicle_refuses_what_ardupilot_refuses(tmp_path, field, v
     refused_flight = run("fly", _plan_variant(tmp_path, "odd.plan", odd), "--speedup", 0)
     assert refused_flight.returncode != 0 and "Traceback" not in refused_flight.stderr
     assert answer in refused_flight.stderr, refused_flight.stderr
+
+
+def test_a_plan_without_the_altitude_mode_is_read_as_qgroundcontrol_reads_it(tmp_path):
+    def older(document):
+        del document["mission"]["globalPlanAltitudeMode"]
+    result = run("fly", _plan_variant(tmp_path, "old.plan", older), "--speedup", 0)
+    assert result.returncode == 0, result.stderr
+
+
+def test_a_copter_plan_is_refused(tmp_path):
+    def copter(document):
+        document["mission"]["vehicleType"] = 2
+    refused(run("fly", _plan_variant(tmp_path, "copter.plan", copter), "--speedup", 0),
+            "vehicleType 2 is a quadrotor")

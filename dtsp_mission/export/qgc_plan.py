@@ -22,6 +22,10 @@ from .base import Exporter
 #: QGroundControl's default fixed-wing cruise speed, written when no airspeed is given (QGC
 #: only uses it for time estimates).
 QGC_DEFAULT_CRUISE_SPEED_M_S = 15.0
+#: MAV_TYPE values of vehicles that are no fixed wing (a plan made for one is not flown here).
+NOT_FIXED_WING = {2: "a quadrotor", 3: "a coaxial helicopter", 4: "a helicopter",
+                  10: "a ground rover", 11: "a surface boat", 12: "a submarine",
+                  13: "a hexarotor", 14: "an octorotor", 15: "a tricopter"}
 #: globalPlanAltitudeMode 1: altitudes relative to home.
 ALTITUDE_MODE_RELATIVE = 1
 
@@ -89,9 +93,16 @@ def plan_rule_violations(data: Any) -> list[str]:
     mission = data["mission"]
     if mission.get("version") != 2:
         problems.append(f"mission.version must be 2, got {mission.get('version')!r}")
-    for key in ("firmwareType", "vehicleType", "globalPlanAltitudeMode"):
+    for key in ("firmwareType", "vehicleType"):
         if not _is_integer(mission.get(key)):
             problems.append(f"mission.{key} must be an integer")
+    # optional in QGroundControl's loader (older versions and other tools omit it)
+    if "globalPlanAltitudeMode" in mission and not _is_integer(mission["globalPlanAltitudeMode"]):
+        problems.append("mission.globalPlanAltitudeMode must be an integer when given")
+    if mission.get("vehicleType") in NOT_FIXED_WING:
+        problems.append(f"mission.vehicleType {mission['vehicleType']} is "
+                        f"{NOT_FIXED_WING[mission['vehicleType']]}: these missions are for "
+                        "fixed wings (vehicleType 1)")
     for key in ("cruiseSpeed", "hoverSpeed"):
         if not _is_number(mission.get(key)):
             problems.append(f"mission.{key} must be a number")
