@@ -19,11 +19,44 @@ def write(tmp_path, name, content):
 
 def test_csv_in_degrees_with_alt_and_names_and_a_duplicate(tmp_path):
     path = write(tmp_path, "t.csv", " Latitude , LON ,alt,Name\n46.8,6.9,50,a\n46.81,6.91,60,b\n"
-                                    "46.8,6.9,70,c\n")
+                                    "46.8,6.9,50,a\n")
     targets = read_targets(path)
     assert isinstance(targets, GeoTargets) and len(targets) == 2
     assert targets.names == ("a", "b") and targets.merged_duplicates == 1
     assert list(targets.altitudes_m) == [50.0, 60.0]
+
+
+@pytest.mark.parametrize("second, field", [("70,a", "altitude"), ("50,c", "name")])
+def test_csv_duplicates_that_disagree_are_refused_naming_both_lines(tmp_path, second, field):
+    path = write(tmp_path, "t.csv", "lat,lon,alt,name\n# a comment\n46.8,6.9,50,a\n\n"
+                                    f"46.81,6.91,60,b\n46.8,6.9,{second}\n")
+    with pytest.raises(InputError, match=f"line 3 and line 6 are at the same position with a "
+                                         f"different {field}"):
+        read_targets(path)
+
+
+def test_csv_lines_are_the_files_lines_and_quoted_fields_may_span_them(tmp_path):
+    path = write(tmp_path, "t.csv", 'lat,lon,name\n46.8,6.9,"pole\nnorth"\n# note\n46.81,6.91,b\n'
+                                    "46.82,abc,c\n")
+    with pytest.raises(FileFormatError, match="line 6: lon must be a number"):
+        read_targets(path)
+    targets = read_targets(write(tmp_path, "u.csv", 'lat,lon,name\n46.8,6.9,"pole\nnorth"\n'
+                                                    "46.81,6.91,b\n"))
+    assert targets.names == ("pole\nnorth", "b")
+
+
+@pytest.mark.parametrize("header, meant", [("lat,lon,atl", "alt"), ("lat,lon,nmae", "name"),
+                                           ("lat,lnog", "lng"), ("lat,lon,phto", "photo")])
+def test_a_misspelt_column_is_refused_naming_the_one_meant(tmp_path, header, meant):
+    row = ",".join(["46.8", "6.9", "1"][:header.count(",") + 1])
+    with pytest.raises(FileFormatError, match=f"did you mean '{meant}'"):
+        read_targets(write(tmp_path, "t.csv", f"{header}\n{row}\n"))
+
+
+def test_columns_not_read_are_named_including_xy_beside_lat_lon(tmp_path):
+    targets = read_targets(write(tmp_path, "t.csv", "lat,lon,y,comment\n46.8,6.9,3,a\n"
+                                                    "46.81,6.91,4,b\n"))
+    assert isinstance(targets, GeoTargets) and set(targets.unused_columns) == {"y", "comment"}
 
 
 def test_csv_in_metres(tmp_path):

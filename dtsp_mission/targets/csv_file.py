@@ -10,9 +10,12 @@ A header row names the columns (case and surrounding spaces ignored):
   ``gimbal_pitch`` (degrees) and ``loiter_turns`` (whole circles); an empty cell: none.
 
 Fields are separated by commas, semicolons or tabs (whichever the header uses); lines starting
-with ``#`` are comments.  Other columns are kept out of the way: they are read, not used, and
-listed in :attr:`~dtsp_mission.targets.model.GeoTargets.unused_columns` so that a typo in a
-column name is still shown to the user.  Errors name the file, line and column.
+with ``#`` are comments; a quoted field may hold the separator or a line break.  A column name
+that looks like a misspelt one (``atl``, ``nmae``) is refused, saying which was meant; other
+columns (and x/y beside lat/lon) are read, not used, and listed in
+:attr:`~dtsp_mission.targets.model.GeoTargets.unused_columns`.  Rows at the same position are
+merged when they agree and refused, naming both lines, when they differ (altitude, name,
+actions).  Errors name the file and the file's line (comments and blank lines counted).
 """
 
 from __future__ import annotations
@@ -27,7 +30,7 @@ from ..errors import FileFormatError
 from ..files import read_text
 from ..frame import check_geodetic
 from ..errors import InputError
-from .actions import actions_from_columns, column_key, parse_cell
+from .actions import COLUMNS as ACTION_COLUMNS, actions_from_columns, column_key, parse_cell
 from .model import GeoTargets, Targets, check_altitudes, geodetic_targets, local_targets
 
 _COLUMNS = {
@@ -35,6 +38,22 @@ _COLUMNS = {
     "x": ("x", "x_m"), "y": ("y", "y_m"),
     "alt": ("alt", "altitude", "alt_m"), "name": ("name",),
 }
+
+
+_DEGREES = {"lat": 90.0, "lon": 180.0}
+
+
+def misspelt_column(label: str, found=()) -> str | None:
+    """The column name ``label`` looks like a misspelling of (one letter off, letters swapped),
+    among the columns not ``found`` already, or None."""
+    import difflib
+    known = [spelling for key, spellings in {**_COLUMNS, **ACTION_COLUMNS}.items()
+             if key not in found for spelling in spellings]
+    for name in known:
+        if len(label) == len(name) and sorted(label) == sorted(name) and label != name:
+            return name                          # letters swapped: atl, lnog
+    close = difflib.get_close_matches(label, known, n=1, cutoff=0.8)
+    return close[0] if close else None
 
 
 def _header(path, header: list[str], line: int) -> tuple[dict[str, int], tuple[str, ...]]:
@@ -56,6 +75,12 @@ def _header(path, header: list[str], line: int) -> tuple[dict[str, int], tuple[s
                 raise FileFormatError(f"{path}, line {line}: column {action!r} is given twice")
             else:
                 found[action] = index
+    for label in unused:
+        meant = misspelt_column(label.lower(), found)
+        if meant:
+            raise FileFormatError(
+                f"{path}, line {line}: column {label!r} is not one this reads: did you mean "
+                f"{meant!r}? (rename it; a column of another name is listed as not used)")
     geodetic = "lat" in found and "lon" in found
     local = "x" in found and "y" in found
     if geodetic == local:
@@ -63,6 +88,11 @@ def _header(path, header: list[str], line: int) -> tuple[dict[str, int], tuple[s
             f"{path}, line {line}: the header must name either columns lat and lon (degrees) or "
             f"x and y (metres), with optional alt (metres above home) and name; found "
             f"{', '.join(h.strip() for h in header)}")
+    unused = list(unused)
+    # a coordinate column of the other system beside a whole pair is read by nobody: say so
+    for key in ("x", "y") if geodetic else ("lat", "lon"):
+        if key in found:
+            unused.append(header[found.pop(key)].strip())
     return found, tuple(unused)
 
 
@@ -77,17 +107,24 @@ def read_csv(path: str | os.PathLike, text: str | None = None) -> GeoTargets | T
     """Targets from a CSV file (``text``: its content, already read); duplicates (same
     coordinates) are merged and counted."""
     text = read_text(path) if text is None else text
-    numbered = [(k, line) for k, line in enumerate(text.splitlines(), start=1)
-                if line.strip() and not line.lstrip().startswith("#")]
-    if not numbered:
+    lines = text.splitlines(keepends=True)
+    content = [line for line in lines if line.strip() and not line.lstrip().startswith("#")]
+    if not content:
         raise FileFormatError(f"{path}: the file is empty")
-    delimiter = _delimiter(numbered[0][1])
+    delimiter = _delimiter(content[0])
+    # comment lines are blanked, not dropped, so that the reader's line count is the file's
+    reader = csv.reader(("\n" if line.lstrip().startswith("#") else line for line in lines),
+                        delimiter=delimiter)
     rows, line_of = [], []
-    for k, line in numbered:
-        row = next(csv.reader([line], delimiter=delimiter))
-        if any(cell.strip() for cell in row):
-            rows.append(row)
-            line_of.append(k)
+    last = 0
+    try:
+        for row in reader:
+            first_line, last = last + 1, reader.line_num
+            if any(cell.strip() for cell in row):
+                rows.append(row)
+                line_of.append(first_line)
+    except csv.Error as error:
+        raise FileFormatError(f"{path}, line {reader.line_num}: {error}") from None
     columns, unused = _header(path, rows[0], line_of[0])
     geodetic = "lat" in columns
     first, second = ("lat", "lon") if geodetic else ("x", "y")
@@ -111,6 +148,10 @@ def read_csv(path: str | os.PathLike, text: str | None = None) -> GeoTargets | T
             if not np.isfinite(value):
                 raise FileFormatError(f"{path}, line {line}: {key} must be a finite number, "
                                       f"got {cell!r}")
+            limit = _DEGREES.get(key)
+            if limit is not None and abs(value) > limit:
+                raise FileFormatError(f"{path}, line {line}: {key} {cell.strip()} is not a number "
+                                      f"between -{limit:g} and {limit:g} degrees")
             values.append(value)
         if "name" in columns:
             names.append(row[columns["name"]].strip())
@@ -122,7 +163,8 @@ def read_csv(path: str | os.PathLike, text: str | None = None) -> GeoTargets | T
     if not names and not numbers[first]:
         raise FileFormatError(f"{path}: there are no targets below the header")
     altitudes = np.array(numbers["alt"]) if "alt" in numbers else None
-    check_altitudes(altitudes, str(path))
+    row_names = [f"line {line}" for line in line_of[1:]]
+    check_altitudes(altitudes, str(path), row_names)
     if altitudes is not None and np.isnan(altitudes).all():
         altitudes = None
     name_tuple = tuple(names) if "name" in columns else None
@@ -130,8 +172,8 @@ def read_csv(path: str | os.PathLike, text: str | None = None) -> GeoTargets | T
     if geodetic:
         check_geodetic(numbers["lat"], numbers["lon"], f"{path}: target")
         targets = geodetic_targets(numbers["lat"], numbers["lon"], name_tuple, altitudes,
-                                   actions=action_arrays)
+                                   actions=action_arrays, where=str(path), rows=row_names)
     else:
         targets = local_targets(np.column_stack([numbers["x"], numbers["y"]]), name_tuple,
-                                altitudes, action_arrays)
+                                altitudes, action_arrays, where=str(path), rows=row_names)
     return replace(targets, unused_columns=unused) if unused else targets

@@ -1,8 +1,9 @@
 """Targets and survey area from GeoJSON (RFC 7946).
 
 Point and MultiPoint features are targets (``[longitude, latitude]``; a third coordinate is
-ignored because GeoJSON does not say what it is relative to -- use the ``alt`` property, metres
-above home).  A ``name`` property names a target; ``photo``, ``roi``, ``gimbal_pitch`` and
+refused because GeoJSON does not say what it is relative to -- use the ``alt`` property, metres
+above home).  Other properties are listed as not used; one that looks like a misspelt property
+(``atl``) is refused.  A ``name`` property names a target; ``photo``, ``roi``, ``gimbal_pitch`` and
 ``loiter_turns`` properties are its actions (:mod:`.actions`).  One Polygon feature, if present, is the
 survey area.  Any other geometry is an error.
 """
@@ -11,6 +12,7 @@ from __future__ import annotations
 
 import json
 import os
+from dataclasses import replace
 from typing import Any
 
 import numpy as np
@@ -22,8 +24,13 @@ from ..errors import FileFormatError
 from ..files import read_text
 from ..frame import check_geodetic
 from ..errors import InputError
-from .actions import COLUMNS, actions_from_columns, parse_cell
+from .actions import COLUMNS, actions_from_columns, column_key, parse_cell
+from .csv_file import misspelt_column
 from .model import GeoTargets, check_altitudes, geodetic_targets
+
+
+#: The properties read besides the actions.
+_KNOWN_PROPERTIES = ("name", "alt")
 
 
 def _features(data: Any, path) -> list[dict]:
@@ -69,6 +76,8 @@ def read_geojson(path: str | os.PathLike, text: str | None = None) -> GeoTargets
     names: list[str] = []
     altitudes: list[float] = []
     action_cells: dict[str, list] = {}
+    unused: dict[str, None] = {}
+    row_names: list[str] = []
     area = None
     for number, feature in enumerate(_features(data, path), start=1):
         where = f"{path}, feature {number}"
@@ -103,6 +112,14 @@ def read_geojson(path: str | os.PathLike, text: str | None = None) -> GeoTargets
                     "and the altitude above home as the 'alt' property")
             longitudes.append(float(point[0]))
             latitudes.append(float(point[1]))
+            row_names.append(f"feature {number}")
+            for key in properties:
+                if (str(key).strip().lower() not in _KNOWN_PROPERTIES and column_key(str(key)) is None):
+                    meant = misspelt_column(str(key).strip().lower(), ())
+                    if meant:
+                        raise FileFormatError(f"{where}: property {key!r} is not one this reads: "
+                                              f"did you mean {meant!r}?")
+                    unused[str(key)] = None
             names.append(str(properties.get("name", "")))
             altitude = properties.get("alt")
             if altitude is not None and (isinstance(altitude, bool)
@@ -131,7 +148,9 @@ def read_geojson(path: str | os.PathLike, text: str | None = None) -> GeoTargets
             altitude_array = np.array(altitudes, dtype=float)
         except (TypeError, ValueError):
             raise FileFormatError(f"{path}: every 'alt' property must be a number") from None
-        check_altitudes(altitude_array, str(path))
+        check_altitudes(altitude_array, str(path), row_names)
     name_tuple = tuple(names) if any(names) else None
-    return geodetic_targets(latitudes, longitudes, name_tuple, altitude_array, area,
-                            actions_from_columns(action_cells, len(latitudes)))
+    targets = geodetic_targets(latitudes, longitudes, name_tuple, altitude_array, area,
+                               actions_from_columns(action_cells, len(latitudes)), where=str(path),
+                               rows=row_names)
+    return replace(targets, unused_columns=tuple(unused)) if unused else targets

@@ -3,7 +3,7 @@
 from __future__ import annotations
 
 from dataclasses import dataclass, replace
-from typing import TYPE_CHECKING
+from typing import TYPE_CHECKING, Sequence
 
 import numpy as np
 from scipy.spatial import cKDTree
@@ -101,17 +101,49 @@ class GeoTargets:
 MAX_ALTITUDE_M = 10_000.0
 
 
-def check_altitudes(altitudes_m: np.ndarray | None, where: str) -> None:
+def check_altitudes(altitudes_m: np.ndarray | None, where: str,
+                    rows: Sequence[str] | None = None) -> None:
     """Raise :class:`InputError` unless every altitude is a finite number above zero (or NaN:
-    not given, the mission's altitude)."""
+    not given, the mission's altitude); the error names the row as ``rows`` does (``"line
+    7"``), or the target's number.  The floor above home is the mission's to check."""
     if altitudes_m is None:
         return
     given = ~np.isnan(altitudes_m)
     bad = given & (~np.isfinite(altitudes_m) | (altitudes_m <= 0.0) | (altitudes_m > MAX_ALTITUDE_M))
     if bad.any():
         index = int(np.argmax(bad))
-        raise InputError(f"{where}, target {index + 1}: altitude {float(altitudes_m[index])!r} m must be "
+        row = rows[index] if rows is not None else f"target {index + 1}"
+        raise InputError(f"{where}, {row}: altitude {float(altitudes_m[index])!r} m must be "
                          f"a number above 0 and at most {MAX_ALTITUDE_M:,.0f} (metres above home)")
+
+
+def _same(a, b) -> bool:
+    return bool(a == b or (isinstance(a, float) and isinstance(b, float) and np.isnan(a) and np.isnan(b)))
+
+
+def check_conflicts(leader: np.ndarray, names, altitudes_m, actions: "TargetActions | None",
+                    where: str, rows: Sequence[str] | None) -> None:
+    """Raise :class:`InputError` naming both rows when two targets at the same position ask
+    for different altitudes, actions or names (merging would silently drop one of them);
+    ``leader`` is :func:`cluster_positions`' second result mapped back to row indices."""
+    fields = []
+    if altitudes_m is not None:
+        fields.append(("altitude", lambda i: float(altitudes_m[i])))
+    if names is not None:
+        fields.append(("name", lambda i: names[i]))
+    if actions is not None:
+        fields += [("photo", lambda i: bool(actions.photo[i])), ("roi", lambda i: bool(actions.roi[i])),
+                   ("gimbal_pitch", lambda i: float(actions.gimbal_pitch_deg[i])),
+                   ("loiter_turns", lambda i: int(actions.loiter_turns[i]))]
+    for j in np.flatnonzero(leader != np.arange(len(leader))):
+        i = int(leader[j])
+        for label, value in fields:
+            if not _same(value(i), value(int(j))):
+                first, second = ((rows[i], rows[j]) if rows is not None
+                                 else (f"target {i + 1}", f"target {j + 1}"))
+                raise InputError(f"{where}: {first} and {second} are at the same position with a "
+                                 f"different {label} ({value(i)!r} and {value(int(j))!r}); "
+                                 "remove one of them or move it")
 
 
 def cluster_positions(positions: np.ndarray, resolution: float = 0.0) -> tuple[np.ndarray, np.ndarray]:
@@ -156,20 +188,33 @@ def _pick(values, keep):
     return np.asarray(values)[keep]
 
 
+def _merged(positions, names, altitudes_m, actions, where: str, rows):
+    keep, index_in_keep = cluster_positions(positions)
+    if len(keep) < len(positions):
+        check_conflicts(keep[index_in_keep], names, altitudes_m, actions, where, rows)
+    return keep, len(positions) - len(keep)
+
+
 def local_targets(positions_m: np.ndarray, names=None, altitudes_m=None,
-                  actions: TargetActions | None = None) -> Targets:
-    """:class:`Targets` with exact duplicates merged (the first one kept)."""
-    keep, merged = merge_duplicates(positions_m)
+                  actions: TargetActions | None = None, where: str = "targets",
+                  rows: Sequence[str] | None = None) -> Targets:
+    """:class:`Targets` with exact duplicates merged (the first one kept); :class:`InputError`
+    if duplicates differ in altitude, name or actions (naming the two as ``rows`` does)."""
+    keep, merged = _merged(np.asarray(positions_m, dtype=float), names, altitudes_m, actions,
+                           where, rows)
     return Targets(np.asarray(positions_m, dtype=float)[keep], _pick(names, keep), merged,
                    _pick(altitudes_m, keep), actions=_pick(actions, keep))
 
 
 def geodetic_targets(latitudes_deg: np.ndarray, longitudes_deg: np.ndarray, names=None,
                      altitudes_m=None, area_deg=None,
-                     actions: TargetActions | None = None) -> GeoTargets:
-    """:class:`GeoTargets` with exact duplicates merged (the first one kept)."""
+                     actions: TargetActions | None = None, where: str = "targets",
+                     rows: Sequence[str] | None = None) -> GeoTargets:
+    """:class:`GeoTargets` with exact duplicates merged (the first one kept); as
+    :func:`local_targets` for duplicates that differ."""
     latitudes = np.asarray(latitudes_deg, dtype=float)
     longitudes = np.asarray(longitudes_deg, dtype=float)
-    keep, merged = merge_duplicates(np.column_stack([latitudes, longitudes]))
+    keep, merged = _merged(np.column_stack([latitudes, longitudes]), names, altitudes_m, actions,
+                           where, rows)
     return GeoTargets(latitudes[keep], longitudes[keep], _pick(names, keep), merged,
                       _pick(altitudes_m, keep), area_deg, actions=_pick(actions, keep))
