@@ -1,7 +1,8 @@
 """Reading and writing files with clear errors; every write is atomic.
 
 An output file is either written completely or not touched at all: content goes to a temporary
-file in the same directory, is flushed to disk, and replaces the target in one rename.
+file in the same directory, is flushed to disk, and replaces the target in one rename.  Several
+outputs are staged together and renamed only when every one is on disk (:func:`write_together`).
 """
 
 from __future__ import annotations
@@ -10,6 +11,7 @@ import os
 import stat
 import tempfile
 from pathlib import Path
+from typing import Callable, Sequence
 
 from .errors import FileAccessError
 
@@ -65,7 +67,40 @@ def check_replaceable(path: str | os.PathLike) -> None:
 
 def write_atomic(path: str | os.PathLike, content: str | bytes) -> Path:
     """Write ``content`` to ``path`` so that readers see the old file or the whole new one."""
-    path = Path(path)
+    return write_together([(path, content)])[0]
+
+
+def write_together(outputs: Sequence[tuple[str | os.PathLike, str | bytes]],
+                   before_commit: Callable[[], None] | None = None) -> list[Path]:
+    """Write every output or none.
+
+    Each content is written and flushed to a temporary file beside its target; only when all
+    are written (and ``before_commit``, if given, has returned -- an upload, say) are they
+    renamed into place, one after the other.  If anything fails first, the temporary files are
+    removed and no target is touched.  A target that exists must be a regular file."""
+    staged: list[tuple[Path, str]] = []
+    try:
+        for path, content in outputs:
+            staged.append((Path(path), _stage(Path(path), content)))
+        if before_commit is not None:
+            before_commit()
+        for path, temporary in staged:
+            check_replaceable(path)
+            try:
+                os.replace(temporary, path)
+            except OSError as error:
+                raise FileAccessError(f"{path}: cannot be written ({error.strerror})") from None
+    finally:
+        for _, temporary in staged:
+            try:
+                os.unlink(temporary)
+            except OSError:
+                pass
+    return [path for path, _ in staged]
+
+
+def _stage(path: Path, content: str | bytes) -> str:
+    """A temporary file beside ``path`` holding ``content``, flushed to disk."""
     data = content.encode("utf-8") if isinstance(content, str) else content
     check_replaceable(path)
     directory = path.parent if str(path.parent) else Path(".")
@@ -82,7 +117,6 @@ def write_atomic(path: str | os.PathLike, content: str | bytes) -> Path:
             stream.flush()
             os.fsync(stream.fileno())
         os.chmod(temporary, 0o644)
-        os.replace(temporary, path)
     except BaseException as error:
         try:
             os.unlink(temporary)
@@ -91,4 +125,4 @@ def write_atomic(path: str | os.PathLike, content: str | bytes) -> Path:
         if isinstance(error, OSError):
             raise FileAccessError(f"{path}: cannot be written ({error.strerror})") from None
         raise
-    return path
+    return temporary

@@ -56,8 +56,14 @@ def _nice_length(span_m: float) -> float:
 
 def draw_plan(product: Mission | Tour, path: str | os.PathLike,
               area_m: np.ndarray | None = None, title: str = "") -> Path:
-    """Write a picture of ``product`` to ``path`` (atomically; PNG, SVG, PDF or JPEG by the
-    extension): the flight path with arrows in the direction of flight, the targets with their
+    """Write :func:`render_plan`'s picture to ``path`` (atomically; PNG, SVG, PDF or JPEG by
+    the extension)."""
+    return write_atomic(path, render_plan(product, plot_format(path), area_m, title))
+
+
+def render_plan(product: Mission | Tour, image_format: str,
+                area_m: np.ndarray | None = None, title: str = "") -> bytes:
+    """A picture of ``product`` in ``image_format`` (png, svg, pdf, jpg): the flight path with arrows in the direction of flight, the targets with their
     visit numbers, take-off and the return to home for a mission, a scale bar and north, the
     legend below the map.  SVG text stays text (searchable, editable)."""
     require_matplotlib()
@@ -129,6 +135,6 @@ def draw_plan(product: Mission | Tour, path: str | os.PathLike,
     axes.legend(loc="upper center", bbox_to_anchor=(0.5, -0.07), ncol=2, fontsize=8,
                 frameon=False)
     buffer = io.BytesIO()
-    figure.savefig(buffer, format=plot_format(path), bbox_inches="tight")
+    figure.savefig(buffer, format=image_format, bbox_inches="tight")
     plt.close(figure)
-    return write_atomic(path, buffer.getvalue())
+    return buffer.getvalue()

@@ -148,3 +148,16 @@ def test_a_copter_plan_is_refused(tmp_path):
         document["mission"]["vehicleType"] = 2
     refused(run("fly", _plan_variant(tmp_path, "copter.plan", copter), "--speedup", 0),
             "vehicleType 2 is a quadrotor")
+
+
+def test_plan_upload_to_nothing_leaves_no_file(tmp_path):
+    import socket
+    with socket.socket() as probe:                  # a loopback port where nothing listens
+        probe.bind(("127.0.0.1", 0))
+        port = probe.getsockname()[1]
+    (tmp_path / "t.csv").write_text("lat,lon\n46.80,6.95\n46.81,6.96\n46.805,6.97\n")
+    result = run("plan", tmp_path / "t.csv", "--radius", 80, "--time-limit", 1, "--design",
+                 "geometry", "-o", tmp_path / "o.plan", "-o", tmp_path / "o.waypoints",
+                 "--plot", tmp_path / "o.png", "--upload", f"tcp:127.0.0.1:{port}")
+    assert result.returncode != 0 and "Traceback" not in result.stderr, result.stderr
+    assert sorted(p.name for p in tmp_path.iterdir()) == ["t.csv"]

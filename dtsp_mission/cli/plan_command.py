@@ -12,7 +12,7 @@ import numpy as np
 from ..dubins.path import check_radius
 from ..export import exporter_for
 from ..errors import DtspError
-from ..files import check_replaceable, write_atomic
+from ..files import check_replaceable, write_together
 from ..mission import Autopilot, MissionSettings
 from ..mission.build import targets_beyond
 from ..mission.sorties import sortie_path
@@ -20,7 +20,7 @@ from ..pipeline import PlanRequest, PlanResult, run_plan
 from ..planning import planners
 from ..planning.base import MERGE_RESOLUTION_RHO
 from ..planning.rbta import region_heading_deg
-from ..plot import draw_plan, plot_format, require_matplotlib
+from ..plot import plot_format, render_plan, require_matplotlib
 from ..targets import GeoTargets, Targets, random_targets, read_targets
 from ..targets.actions import TargetActions, check_loiter_turns
 from ..targets.geojson_file import read_geojson
@@ -147,7 +147,7 @@ def _duration(seconds: float) -> str:
 @apply(console_options)
 @reports_errors
 def plan(targets_file, random_count, area_file, seed, origin, rho_m, airspeed_m_s, max_bank_deg,
-         altitude_m, home_deg, home_amsl_m, launch_bearing_deg, landing_bearing_deg, autopilot,
+         altitude_m, min_altitude_m, home_deg, home_amsl_m, launch_bearing_deg, landing_bearing_deg, autopilot,
          return_mode, design, max_miss_m, wind_spread_m_s, tolerance_m, max_items, algorithm, region, time_limit_s,
          fallback, outputs, format_name,
          plot_file, connection, via, verify, signing_key_file, transfer_timeout_s, endurance_min,
@@ -206,7 +206,8 @@ def plan(targets_file, random_count, area_file, seed, origin, rho_m, airspeed_m_
                                     max_miss_m, tolerance_m, max_items, designed_for,
                                     photo=photo, roi=roi, gimbal_pitch_deg=gimbal_pitch_deg,
                                     loiter_radius_m=loiter_radius_m, wind=wind or CALM,
-                                    wind_spread_m_s=wind_spread_m_s)
+                                    wind_spread_m_s=wind_spread_m_s,
+                                    min_altitude_m=min_altitude_m)
         settings.checked(rho)          # refused before planning, not after
         if autopilot == "px4" and any(writer.name == "waypoints" for _, writer in writers):
             note("a .waypoints file holds the home in its row 0, as QGroundControl, Mission "
@@ -247,24 +248,34 @@ def plan(targets_file, random_count, area_file, seed, origin, rho_m, airspeed_m_
     if sorties and connection:
         raise UserError(f"the mission is split into {len(sorties)} sorties (one file each); "
                         "upload them one at a time with `dtsp-mission upload FILE`")
-    # All or nothing: every file is rendered before the first is written.
+    # All or nothing: every output is rendered and staged beside its target; the upload (if
+    # asked) runs before they are renamed into place, so a failed upload leaves no new file.
     rendered = []
     frame = result.frame
     for output, writer in writers:
         if sorties and writer.needs_mission:
-            rendered += [(sortie_path(output, k + 1), writer,
+            rendered += [(sortie_path(output, k + 1), writer.description,
                           writer.render_for(sortie.mission, sortie_path(output, k + 1)))
                          for k, sortie in enumerate(sorties)]
         else:
-            rendered.append((output, writer, writer.render_for(product, output, frame)))
-    for output, writer, content in rendered:
-        write_atomic(output, content)
-        say(f"wrote {output} ({writer.description})")
-        console.current().summary.setdefault("files", []).append(str(output))
+            rendered.append((output, writer.description, writer.render_for(product, output, frame)))
     if plot_file:
-        draw_plan(product, plot_file, result.area_m)
-        say(f"wrote {plot_file} (plot)")
-        record(plot=str(plot_file))
+        rendered.append((plot_file, "plot", render_plan(product, plot_format(plot_file),
+                                                         result.area_m)))
+    upload = None
+    if connection:
+        from .upload_command import run_upload
+
+        def upload() -> None:
+            run_upload(product.for_vehicle(), connection, via, verify, signing_key_file,
+                       designed_for=designed_for, transfer_timeout_s=transfer_timeout_s)
+    write_together([(output, content) for output, _, content in rendered], before_commit=upload)
+    for output, description, _ in rendered:
+        say(f"wrote {output} ({description})")
+        if description == "plot":
+            record(plot=str(output))
+        else:
+            console.current().summary.setdefault("files", []).append(str(output))
     if simulate:
         from ..sim.fly import planned_targets
         from .fly_command import run_flight_check
@@ -276,10 +287,6 @@ def plan(targets_file, random_count, area_file, seed, origin, rho_m, airspeed_m_
             run_flight_check(flown.for_vehicle(), planned_targets(flown), airframe, via,
                              speedup, max_miss_m, max_items, wind)
             console.current().summary.setdefault("simulated", []).append(console.current().summary.pop("flight"))
-    if connection:
-        from .upload_command import run_upload
-        run_upload(product.for_vehicle(), connection, via, verify, signing_key_file,
-                   designed_for=designed_for, transfer_timeout_s=transfer_timeout_s)
     console.finish()
 
 
