@@ -45,7 +45,10 @@ class LinkError(DtspError, OSError):
     to ArduPilot is not atomic); empty when nothing is known.
     """
 
-    def __init__(self, message: str, on_vehicle: str = "") -> None:
+    def __init__(self, message: str, on_vehicle: str = "", nothing_sent: bool = False) -> None:
         super().__init__(message + (f"; {on_vehicle}" if on_vehicle else ""))
         self.reason = message
         self.on_vehicle = on_vehicle
+        #: the vehicle refused the mission before asking for any item (MISSION_COUNT refused):
+        #: by the mission protocol it keeps the mission it held
+        self.nothing_sent = nothing_sent

@@ -22,7 +22,7 @@ from .dubins.path import check_radius
 from .errors import InputError, MissionTooLarge
 from .frame import LocalFrame, mission_centre
 from .mission import Mission, MissionSettings, build_mission
-from .mission.build import (GUIDANCE_MARGINS, check_storage, length_excess, targets_beyond,
+from .mission.build import (GUIDANCE_MARGINS, check_altitude_floor, check_storage, length_excess, targets_beyond,
                             with_turn_margin)
 from .mission.sorties import Sortie, split_into_sorties
 from .planning import TilingUnavailable, get_planner
@@ -169,6 +169,9 @@ def run_plan(request: PlanRequest,
     if request.settings is not None and frame is None:
         raise InputError("a mission needs targets in degrees: these are local x/y metres, so "
                          "give their origin (lat, lon)")
+    if request.settings is not None:
+        request.settings.checked(request.rho_m)
+        check_altitude_floor(geodetic, request.settings)
     notes: list[str] = []
     if local.merged_duplicates:
         notes.append(f"{local.merged_duplicates} duplicate targets merged ({len(local)} remain)")

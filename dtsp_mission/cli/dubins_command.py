@@ -16,10 +16,12 @@ def _pose(text: str) -> np.ndarray:
         x, y, heading_deg = (float(v) for v in text.split(","))
     except ValueError:
         raise click.BadParameter(f"{text!r} is not X_M,Y_M,HEADING_DEG") from None
+    if not all(map(math.isfinite, (x, y, heading_deg))):
+        raise click.BadParameter(f"{text!r}: every number must be finite")
     return np.array([x, y, math.radians(heading_deg)])
 
 
-@click.command()
+@click.command(context_settings={"ignore_unknown_options": True})   # -5,0,0 is a pose
 @click.argument("start", metavar="X_M,Y_M,HEADING_DEG")
 @click.argument("goal", metavar="X_M,Y_M,HEADING_DEG")
 @radius_option

@@ -7,7 +7,7 @@ import click
 import numpy as np
 
 from ..autopilot.navigation import CALM, check_wind
-from ..sim.fly import FlightCheck, fly_mission, targets_from, targets_in
+from ..sim.fly import FlightCheck, check_targets_near, fly_mission, targets_from, targets_in
 from . import console
 from .console import console_options, note, record, say
 from .options import (UserError, apply, progress_reporter, reports_errors, simulation_options,
@@ -41,7 +41,8 @@ def print_check(check: FlightCheck) -> None:
     record(flight={"completed": check.completed, "items_reached": check.items_reached,
                    "items": check.items, "flight_time_s": check.flight_time_s,
                    "min_turn_radius_m": check.min_turn_radius_m, "position_reports": check.samples,
-                   "targets": [{"name": name, "miss_m": miss, "altitude_error_m": altitude}
+                   "targets": [{"name": name, "miss_m": miss,
+                                "altitude_error_m": altitude if np.isfinite(altitude) else None}
                                for name, miss, altitude in zip(check.names, check.miss_m,
                                                                check.altitude_error_m)],
                    "max_miss_m": check.max_miss_m})
@@ -56,7 +57,8 @@ def print_check(check: FlightCheck) -> None:
                    f"{check.max_miss_m:.2f} m")
         say("target\tmiss_m\taltitude_error_m")
         for name, miss, altitude in zip(check.names, check.miss_m, check.altitude_error_m):
-            say(f"{name}\t{miss:.2f}\t{altitude:+.1f}")
+            say(f"{name}\t{miss:.2f}\t" + (f"{altitude:+.1f}" if np.isfinite(altitude)
+                                            else "-"))    # no altitude given for the target
 
 
 @click.command()
@@ -100,6 +102,7 @@ def fly(mission_file, rho_m, airspeed_m_s, max_bank_deg, speedup, vehicle_params
                  "aims them off the targets): give --targets FILE to measure to the targets")
         else:
             targets = targets_from(read_geodetic_targets(targets_file))
+            check_targets_near(mission, targets, f"--targets {targets_file}")
         if wind is not None:
             check_wind(wind, airframe.airspeed_m_s)
             say(f"wind {wind}")

@@ -110,6 +110,9 @@ vehicle_options = [
 mission_options = [
     click.option("--alt", "altitude_m", type=float, default=100.0, show_default=True,
                  metavar="METRES", help="Cruise altitude above home (targets with an 'alt' use theirs)."),
+    click.option("--min-alt", "min_altitude_m", type=float, default=30.0, show_default=True,
+                 metavar="METRES", help="Altitude floor above home: no cruise or target altitude "
+                 "below it (lower it only where the site is clear that low)."),
     click.option("--home", "home_deg", type=LAT_LON,
                  help="Launch and home position (default: the centre of the targets)."),
     click.option("--home-amsl", "home_amsl_m", type=float, default=0.0, show_default=True,
@@ -150,7 +153,7 @@ mission_options = [
 def mission_settings(autopilot, altitude_m, airspeed_m_s, home_deg, home_amsl_m,
                      launch_bearing_deg, landing_bearing_deg, return_mode, design, max_miss_m,
                      tolerance_m, max_items, vehicle=None, wind=None, wind_spread_m_s=None,
-                     **actions):
+                     min_altitude_m=30.0, **actions):
     """The :class:`MissionSettings` of the :data:`mission_options` values (``vehicle``: the
     :class:`~dtsp_mission.autopilot.parameters.VehicleParameters` the mission is for;
     ``actions``: photo, roi, gimbal_pitch_deg, loiter_radius_m)."""
@@ -160,7 +163,8 @@ def mission_settings(autopilot, altitude_m, airspeed_m_s, home_deg, home_amsl_m,
                            launch_bearing_deg, landing_bearing_deg, return_mode, tolerance_m,
                            max_items, design=design, max_miss_m=max_miss_m, vehicle=vehicle,
                            wind=wind if wind is not None else CALM,
-                           wind_spread_m_s=wind_spread_m_s, **actions)
+                           wind_spread_m_s=wind_spread_m_s, min_altitude_m=min_altitude_m,
+                           **actions)
 
 
 def apply(options: list) -> Callable:

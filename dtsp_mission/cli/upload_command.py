@@ -84,7 +84,7 @@ def upload(mission_file, connection, via, verify, signing_key_file, transfer_tim
     """
     from ..export import exporter_for, read_mission
     console.start(quiet, as_json)
-    if exporter_for(mission_file, format_name).name == "tour":
+    if exporter_for(mission_file, format_name, reading=True).name == "tour":
         mission = _tour_mission(mission_file, mission_settings(**mission_option_values))
     else:
         mission = read_mission(mission_file, format_name)

@@ -23,9 +23,13 @@ def exporters() -> dict[str, type[Exporter] | Exception]:
                       "an Exporter subclass")
 
 
-def exporter_for(path: str | os.PathLike, format_name: str | None = None) -> Exporter:
-    """The exporter named ``format_name``, or else the one whose extensions match ``path``."""
+def exporter_for(path: str | os.PathLike, format_name: str | None = None,
+                 reading: bool = False) -> Exporter:
+    """The exporter named ``format_name``, or else the one whose extensions match ``path``;
+    ``reading``: among the formats a mission is read from (and the tour)."""
     available = working(exporters())
+    if reading:
+        available = {n: e for n, e in available.items() if e.readable or n == "tour"}
     if format_name is not None:
         if format_name not in available:
             raise InputError(f"unknown output format {format_name!r} (installed: "
@@ -36,7 +40,8 @@ def exporter_for(path: str | os.PathLike, format_name: str | None = None) -> Exp
                if name.endswith(ext)]
     if not matches:
         known = ", ".join(sorted(ext for e in available.values() for ext in e.extensions))
-        raise InputError(f"{path}: cannot tell the output format from the file name; use one of "
+        raise InputError(f"{path}: cannot tell the {'mission' if reading else 'output'} format "
+                         f"from the file name; {'this reads' if reading else 'use'} one of "
                          f"{known}, or --format")
     return available[max(matches)[1]]()
 
@@ -44,7 +49,7 @@ def exporter_for(path: str | os.PathLike, format_name: str | None = None) -> Exp
 def read_mission(path: str | os.PathLike, format_name: str | None = None):
     """The :class:`~dtsp_mission.mission.VehicleMission` in a mission file (``.plan``,
     ``.waypoints``, or any readable plugin format)."""
-    exporter = exporter_for(path, format_name)
+    exporter = exporter_for(path, format_name, reading=True)
     if not exporter.readable:
         readable = ", ".join(sorted(ext for e in working(exporters()).values() if e.readable
                                     for ext in e.extensions))

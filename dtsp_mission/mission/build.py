@@ -62,6 +62,12 @@ MIN_WIND_SPREAD_M_S = 1.0
 WIND_SPREAD_DEG = 20.0
 
 
+#: No cruise or target altitude below this many metres above home unless the user lowers the
+#: floor: below it a fixed wing meets trees, masts and buildings, and a mistyped ``alt`` (0.5,
+#: a target at 0.001 m) is far likelier than a site that is clear at that height.
+DEFAULT_MIN_ALTITUDE_M = 30.0
+
+
 @dataclass(frozen=True)
 class MissionSettings:
     """How to turn a tour into a mission.  ``None`` means the default stated in each note."""
@@ -90,6 +96,8 @@ class MissionSettings:
                                               # default DEFAULT_WIND_SPREAD of it, at least 1 m/s
     model_margin_m: float | None = None       # guidance: held this much inside max_miss_m in the
                                               # model; default MODEL_MARGIN_M
+    min_altitude_m: float = DEFAULT_MIN_ALTITUDE_M  # no target or cruise altitude below this
+                                              # (above home); lower it only for a clear site
 
     def checked(self, rho_m: float) -> "MissionSettings":
         """The settings with defaults filled in, or :class:`InputError` saying what is wrong."""
@@ -102,6 +110,13 @@ class MissionSettings:
             raise InputError(f"altitude {self.altitude_m:g} m above home is beyond "
                              f"{MAX_ALTITUDE_M:g} m, higher than the fixed wings this plans for "
                              "fly (a typo, or feet for metres?)")
+        if not (math.isfinite(self.min_altitude_m) and 0 < self.min_altitude_m <= MAX_ALTITUDE_M):
+            raise InputError(f"the altitude floor (--min-alt) must be a number of metres above 0, "
+                             f"got {self.min_altitude_m!r}")
+        if self.altitude_m < self.min_altitude_m:
+            raise InputError(f"altitude {self.altitude_m:g} m above home is below the floor of "
+                             f"{self.min_altitude_m:g} m (--min-alt); if the site is clear that "
+                             "low, lower the floor explicitly")
         if self.airspeed_m_s is not None and not (math.isfinite(self.airspeed_m_s)
                                                   and self.airspeed_m_s > 0):
             raise InputError(f"airspeed must be a number above 0 m/s, got {self.airspeed_m_s!r}")
@@ -259,10 +274,19 @@ def _guidance_tail(path: FlightPath, tour: Tour, settings: MissionSettings,
     :class:`MissionTooLarge` if the least it needs -- one waypoint per target, the fixed items,
     the tail -- does not fit ``settings.max_items``."""
     tail = _tail_waypoints(path, tour.rho_m, settings)
-    needed = len(tour.targets_m) + _fixed_items(settings, actions) + len(tail)
+    fixed = _fixed_items(settings, actions)
+    needed = len(tour.targets_m) + fixed + len(tail)
     if needed > settings.max_items:
+        kinds = ["take-off"] + (["speed"] if settings.airspeed_m_s is not None else [])
+        kinds += {"rtl": ["return"], "land": ["landing"], "none": []}[settings.return_mode]
+        kinds += (["home slot"] if settings.autopilot == "ardupilot" else [])
+        kinds += ([f"{actions} actions"] if actions else [])
+        parts = [f"{len(tour.targets_m)} for the target(s), one each",
+                 f"{fixed} for {', '.join(kinds)}"]
+        if len(tail):
+            parts.append(f"{len(tail)} to the landing approach")
         raise MissionTooLarge(
-            f"the mission needs at least {needed} items (one per target) but the vehicle holds "
+            f"the mission needs at least {needed} items ({', '.join(parts)}) but the vehicle holds "
             f"{settings.max_items} (--max-items): allow more if it has the space (ArduPilot with "
             "the mission on SD card holds about 4,300) or split the targets into several "
             "missions", needed, settings.max_items)
@@ -320,6 +344,7 @@ def _prepare(tour: Tour, frame: LocalFrame, targets: GeoTargets,
     altitudes = targets.altitudes_m
     if altitudes is not None:       # NaN: not given in the targets file, the mission's altitude
         altitudes = np.where(np.isnan(altitudes), settings.altitude_m, altitudes)
+        check_altitude_floor(targets, settings)
     actions = _actions(targets, settings)
     radius = action_items.loiter_radius_m(tour.rho_m, settings.loiter_radius_m)  # >= rho: checked
     loiters = {int(t): (int(actions.loiter_turns[t]), radius)
@@ -330,6 +355,7 @@ def _prepare(tour: Tour, frame: LocalFrame, targets: GeoTargets,
     path = plan_flight_path(tour, home_m, settings.altitude_m, settings.return_mode, launch,
                             landing, altitudes, loiters)
     at_targets = _action_items(path, frame, targets, actions, settings)
+    notes += _steep_steps(path, targets, settings)
     launch_heading = path.chain.starts[0, 2]
     if settings.launch_bearing_deg is None:
         notes.append(f"launch bearing not given: towards the first target "
@@ -339,6 +365,52 @@ def _prepare(tour: Tour, frame: LocalFrame, targets: GeoTargets,
                      "navigation, and PX4's is not modelled")
         settings = replace(settings, design="geometry")
     return _Prepared(settings, path, at_targets, (home_lat, home_lon), home_m, notes)
+
+
+def check_altitude_floor(targets: GeoTargets, settings: MissionSettings) -> None:
+    """:class:`InputError` naming the first target whose altitude is below the settings'
+    floor (``min_altitude_m`` above home)."""
+    if targets.altitudes_m is None:
+        return
+    altitudes = np.asarray(targets.altitudes_m, dtype=float)
+    low = np.flatnonzero(~np.isnan(altitudes) & (altitudes < settings.min_altitude_m))
+    if len(low):
+        raise InputError(
+            f"{len(low)} target(s) below the altitude floor of {settings.min_altitude_m:g} m "
+            f"above home (--min-alt), first {_target_label(targets, int(low[0]))} at "
+            f"{altitudes[low[0]]:g} m; if the site is clear that low, lower the floor "
+            "explicitly")
+
+
+def _target_label(targets: GeoTargets, index: int) -> str:
+    """How a message names target ``index`` (input order): its name, or its number."""
+    name = targets.names[index] if targets.names else ""
+    return f"target {index + 1} ({name})" if name else f"target {index + 1}"
+
+
+def _steep_steps(path: FlightPath, targets: GeoTargets, settings: MissionSettings) -> list[str]:
+    """Warnings for altitude changes between targets steeper than the aircraft climbs or
+    sinks at its airspeed (TECS_CLMB_MAX, TECS_SINK_MAX): it reaches such a target off its
+    altitude."""
+    vehicle = settings.vehicle or ARDUPLANE_DEFAULTS
+    airspeed = settings.airspeed_m_s or vehicle.AIRSPEED_CRUISE
+    knots_s, knots_alt = path.altitudes_at_s
+    steps = np.diff(knots_alt)
+    runs = np.maximum(np.diff(knots_s), 1e-9)
+    rates = steps / runs * airspeed               # m/s of climb (+) or sink (-) the step needs
+    limit = np.where(steps > 0, vehicle.TECS_CLMB_MAX, vehicle.TECS_SINK_MAX)
+    steep = np.flatnonzero((np.abs(rates) > limit * (1 + 1e-9)) & (np.abs(steps) > 1.0))
+    if not len(steep):
+        return []
+    k = int(steep[0])
+    target_at = {float(s): t for t, s in enumerate(path.target_s_m)}
+    where = target_at.get(float(knots_s[k + 1]))
+    label = _target_label(targets, where) if where is not None else "the landing approach"
+    verb, name = ("climb", "TECS_CLMB_MAX") if steps[k] > 0 else ("descent", "TECS_SINK_MAX")
+    return [f"warning: {len(steep)} altitude step(s) steeper than the aircraft climbs or sinks "
+            f"at {airspeed:g} m/s; first, to {label}: a {verb} of {abs(steps[k]):.0f} m in "
+            f"{runs[k]:.0f} m of flight needs {abs(rates[k]):.1f} m/s ({name} "
+            f"{float(limit[k]):g} m/s): the aircraft reaches it off its altitude"]
 
 
 def check_storage(tour: Tour, frame: LocalFrame, targets: GeoTargets,

@@ -60,6 +60,9 @@ class Home:
 
 
 _POSITIONLESS_FRAMES = {2}      # MAV_FRAME_MISSION: x and y are parameters, not a position
+#: Frames whose altitude is above home or above the terrain (GLOBAL_RELATIVE_ALT, _INT,
+#: GLOBAL_TERRAIN_ALT, _INT): a navigation item there below 0 flies into the ground.
+_ABOVE_HOME_FRAMES = {3, 6, 10, 11}
 
 
 @dataclass(frozen=True)
@@ -80,8 +83,9 @@ class VehicleMission:
     design_wind: tuple[float, float] | None = None
 
     def problems(self) -> list[str]:
-        """What no autopilot would take from this mission: a home or an item position off
-        the globe (MAVLink's int32 degrees x 1e7 cannot even carry it) or not a number."""
+        """What no autopilot would take, or no operator would fly, from this mission: a home or
+        an item position off the globe (MAVLink's int32 degrees x 1e7 cannot even carry it) or
+        not a number; a navigation item (other than a landing) below home or the terrain."""
         found = []
         if not (-90 <= self.home.latitude_deg <= 90 and -180 <= self.home.longitude_deg <= 180):
             found.append(f"home ({self.home.latitude_deg:g}, {self.home.longitude_deg:g}) is not "
@@ -93,6 +97,11 @@ class VehicleMission:
                 found.append(f"item {number} (command {int(item.command)}) is at latitude "
                              f"{item.latitude_deg:g}, longitude {item.longitude_deg:g}: not a "
                              "position in degrees")
+            elif (int(item.frame) in _ABOVE_HOME_FRAMES and int(item.command) < 100
+                  and int(item.command) != Command.NAV_LAND
+                  and not (item.altitude_m >= 0)):       # NaN too
+                found.append(f"item {number} (command {int(item.command)}) is {item.altitude_m:g} m "
+                             "above home: below the ground the aircraft took off from")
         return found
 
 

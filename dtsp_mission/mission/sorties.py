@@ -119,8 +119,9 @@ def split_into_sorties(tour: Tour, frame: LocalFrame, targets: GeoTargets,
             return sorties
         except (MissionTooLarge, _TooLong) as error:
             last_error = error
+    max_items = settings.checked(tour.rho_m).max_items
     raise InputError(f"even {min(MAX_SORTIES, n)} sorties do not fit the vehicle "
-                     f"({settings.max_items} items"
+                     f"({max_items} items"
                      f"{f', {endurance_s / 60:g} min of endurance' if endurance_s else ''}): {last_error}")
 
 

@@ -17,7 +17,8 @@ import numpy as np
 
 from pymavlink import mavutil
 
-from ..errors import LinkError
+from ..errors import InputError, LinkError
+from ..frame import LocalFrame
 from ..mission import Command, VehicleMission
 from ..upload import UploadReport, upload_mission
 from ..upload.pymavlink_link import GCS_COMPONENT_ID, GCS_SYSTEM_ID, use_mavlink2
@@ -56,6 +57,27 @@ def targets_from(geodetic) -> Targets:
     names = geodetic.names or tuple(f"target {i + 1}" for i in range(count))
     return Targets(np.asarray(geodetic.latitudes_deg), np.asarray(geodetic.longitudes_deg),
                    altitudes, tuple(names))
+
+
+#: A target farther than this from every position of a mission was not planned with it.
+FAR_FROM_MISSION_M = 5_000.0
+
+
+def check_targets_near(mission: VehicleMission, targets: Targets, where: str) -> None:
+    """:class:`InputError` when a target is more than :data:`FAR_FROM_MISSION_M` from every
+    position of the mission (its home and items): they are not this mission's targets."""
+    frame = LocalFrame(mission.home.latitude_deg, mission.home.longitude_deg)
+    positioned = [i for i in mission.items if i.has_position]
+    places = np.vstack([np.zeros((1, 2))] + ([frame.to_local([i.latitude_deg for i in positioned],
+                                                             [i.longitude_deg for i in positioned])]
+                                             if positioned else []))
+    points = frame.to_local(targets.latitudes_deg, targets.longitudes_deg)
+    gaps = np.array([np.hypot(*(places - point).T).min() for point in points])
+    if len(gaps) and gaps.max() > FAR_FROM_MISSION_M:
+        k = int(np.argmax(gaps))
+        raise InputError(f"{where}: {targets.names[k]} is {gaps[k] / 1000:,.1f} km from the "
+                         "mission's nearest waypoint and its home: these are not the targets "
+                         "this mission was planned for")
 
 
 def targets_in(mission: VehicleMission, names: tuple[str, ...] | None = None) -> Targets:
@@ -120,7 +142,9 @@ def fly_mission(mission: VehicleMission, targets: Targets, airframe: Airframe,
         miss = closest_approach_m(local_track, local_targets)
         # The altitude error where the track comes closest in 3-D: a target under the
         # climb-out is overflown low first and at altitude later.
-        nearest = np.array([int(np.argmin(np.hypot(np.hypot(*(local_track - p).T), track[:, 2] - z)))
+        # A target without an altitude (NaN) has no altitude error.
+        nearest = np.array([int(np.argmin(np.hypot(np.hypot(*(local_track - p).T),
+                                                   track[:, 2] - z if np.isfinite(z) else 0.0)))
                             for p, z in zip(local_targets, targets.altitudes_m)], dtype=np.int64)
         altitude_error = track[nearest, 2] - targets.altitudes_m
     else:

@@ -162,7 +162,8 @@ def upload_mission(mission: VehicleMission, connection: str, via: str = "pymavli
                                     "vehicle is exactly the plan", warnings,
                                     uploader.fresh_starts, _round_trip(uploader),
                                     time.perf_counter() - transfer_started)
-            what = (describe_vehicle(on_vehicle, wire, mission.autopilot) if verify else
+            what = (describe_vehicle(on_vehicle, wire, mission.autopilot, error.nothing_sent)
+                    if verify else
                     "the vehicle may hold part of this mission (not checked: --no-verify)")
             raise LinkError(f"upload failed: {error.reason}", what) from None
         if verify:

@@ -45,8 +45,12 @@ def check_host(connection: str) -> None:
     if not scheme.startswith(("udp", "tcp")):
         return
     host, _, port = rest.rpartition(":")
-    if not port.isdigit() or not 0 <= int(port) <= 65535:
-        raise InputError(f"cannot read the connection {connection!r}: the port must be a number")
+    if not port.isdigit():
+        raise InputError(f"cannot read the connection {connection!r}: the port must be a number "
+                         f"from 1 to 65535, got {port!r}")
+    if not 1 <= int(port) <= 65535:
+        raise InputError(f"cannot read the connection {connection!r}: port {int(port)} is not "
+                         "a port number (1 to 65535)")
     try:
         socket.getaddrinfo(host or "0.0.0.0", int(port))
     except socket.gaierror as error:

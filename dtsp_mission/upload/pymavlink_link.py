@@ -361,7 +361,8 @@ class PymavlinkUploader(Uploader):
         said = f" (the vehicle said: {' / '.join(self._status_texts)})" if self._status_texts else ""
         if result == NO_SPACE:
             return LinkError(f"the vehicle has no room for {count} mission slots "
-                             f"({result_text(result)}){said}: lower --max-items and plan again")
+                             f"({result_text(result)}){said}: lower --max-items and plan again",
+                             nothing_sent=highest < 0)
         if result in ITEM_RESULTS and highest >= 0:
             item = items[highest]
             return LinkError(f"the vehicle rejected item {item.seq} ({_command_name(item.command)}"

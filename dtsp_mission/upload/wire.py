@@ -89,16 +89,20 @@ def differences(planned: list[WireItem], on_vehicle: list[WireItem],
 
 
 def describe_vehicle(on_vehicle: list[WireItem] | None, planned: list[WireItem],
-                     autopilot: Autopilot) -> str:
+                     autopilot: Autopilot, nothing_sent: bool = False) -> str:
     """One sentence on what the vehicle holds, for error messages: unknown, nothing, exactly
-    the plan, its earlier mission, the first k items of the plan (and what follows them), or
-    another mission."""
+    the plan, its earlier mission (``nothing_sent``: the upload was refused before any item
+    went out, so the vehicle kept it), the first k items of the plan (and what follows them),
+    or another mission."""
     if on_vehicle is None:
         return "what the vehicle holds now is unknown (downloading it failed too)"
     first = first_mission_seq(autopilot)
     real = len(on_vehicle) - min(len(on_vehicle), first)
     if real == 0:
         return "the vehicle holds no mission now"
+    if nothing_sent and differences(planned, on_vehicle, autopilot):
+        return (f"no item of this mission was sent: the vehicle kept the mission it held "
+                f"({real} items, downloaded after the refusal)")
     if not differences(planned, on_vehicle, autopilot):
         return "the vehicle holds exactly the planned mission"
     matching = 0

@@ -69,7 +69,24 @@ def test_no_space_leaves_the_earlier_mission_and_says_so(mission, start_vehicle)
     with pytest.raises(LinkError, match="no room for") as caught:
         upload_mission(mission, f"udpout:127.0.0.1:{vehicle.port}")
     assert holds_plan(vehicle, earlier)
-    assert "shares nothing with this one (its earlier mission" in caught.value.on_vehicle
+    slots = len(to_wire(earlier)) - 1               # the home slot is not a mission item
+    assert (f"no item of this mission was sent: the vehicle kept the mission it held ({slots} items"
+            in caught.value.on_vehicle), caught.value.on_vehicle
+
+
+def test_no_space_with_an_earlier_mission_that_starts_alike_is_not_called_a_part(mission,
+                                                                                 start_vehicle):
+    """The issue's case: the earlier mission shares its first items with this one; refused
+    at MISSION_COUNT, the vehicle holds none of this upload, and the message must not say it
+    holds "the first k items of this mission"."""
+    earlier = mission.__class__(mission.items[:3], mission.home, mission.autopilot)
+    vehicle = start_vehicle(mission, max_items=len(to_wire(mission)) - 1)
+    vehicle.mission = to_wire(earlier)
+    with pytest.raises(LinkError, match="no room for") as caught:
+        upload_mission(mission, f"udpout:127.0.0.1:{vehicle.port}")
+    assert holds_plan(vehicle, earlier)
+    assert "the first" not in caught.value.on_vehicle
+    assert "the vehicle kept the mission it held (3 items" in caught.value.on_vehicle
 
 
 def test_a_restart_mid_upload_is_survived_with_a_fresh_transfer(mission, start_vehicle):
