@@ -9,10 +9,11 @@ with it, so a storage normalisation never looks like a corrupted upload while an
 does.
 
 ArduPilot's rules are the ones measured on ArduPlane 4.7 (``tests/data/arduplane-sitl/facts.md``
-and every ``readback.json`` there are golden tests).  PX4's are taken from its mission manager
-as documented (parameters as float32, positions exact to 1e-7 degree); no PX4 flight is in
-the data set, so for PX4 the comparison also treats the plain and ``_INT`` forms of a frame as
-one.
+and every ``readback.json`` there are golden tests).  PX4's are the ones measured on PX4 v1.16.0
+SITL (``tests/data/px4-sitl/storage_probe.json`` and its ``readback.json`` files, golden tests
+too): global frames come back in their ``_INT`` form, NAV_TAKEOFF's param1 and NAV_WAYPOINT's
+param3 are not kept, an item without a position (frame 2) keeps its x and y as 32-bit floats,
+and NAV_LOITER_TURNS is refused.
 """
 
 from __future__ import annotations
@@ -164,26 +165,58 @@ def _ap_params(item: WireItem) -> dict[str, float]:
 
 # -- PX4 ---------------------------------------------------------------------------------------
 
-_PX4_FRAMES = {Frame.GLOBAL_INT: Frame.GLOBAL, Frame.GLOBAL_RELATIVE_ALT_INT: Frame.GLOBAL_RELATIVE_ALT,
-               Frame.GLOBAL_TERRAIN_ALT_INT: Frame.GLOBAL_TERRAIN_ALT}
+#: PX4 returns a global frame in its ``_INT`` form (sent 3, returned 6).
+_PX4_INT_FRAMES = {Frame.GLOBAL: Frame.GLOBAL_INT, Frame.GLOBAL_RELATIVE_ALT: Frame.GLOBAL_RELATIVE_ALT_INT,
+                   Frame.GLOBAL_TERRAIN_ALT: Frame.GLOBAL_TERRAIN_ALT_INT}
+#: PX4's frame for items without a position (MAV_FRAME_MISSION).
+PX4_NO_POSITION_FRAME = 2
+#: Commands PX4 stores with a position (in a global frame); any other it takes only in frame 2
+#: and answers MAV_MISSION_UNSUPPORTED in a global frame (measured for DO_CHANGE_SPEED,
+#: DO_SET_CAM_TRIGG_DIST, IMAGE_START_CAPTURE, DO_SET_ROI_NONE, DO_GIMBAL_MANAGER_PITCHYAW,
+#: DO_LAND_START); the position commands measured are 16, 17, 19, 21, 22 and 201, the VTOL
+#: and loiter-to-altitude ones (31, 84, 85) and DO_SET_ROI_LOCATION (195) as its mission
+#: manager takes them.
+PX4_POSITION_COMMANDS = frozenset({Command.NAV_WAYPOINT, Command.NAV_LOITER_UNLIM,
+                                   Command.NAV_LOITER_TIME, Command.NAV_LAND, Command.NAV_TAKEOFF,
+                                   Command.DO_SET_ROI, 31, 84, 85, 195})
+#: Commands PX4's mission refuses whatever the frame (MAV_MISSION_UNSUPPORTED).
+PX4_REFUSED_COMMANDS = frozenset({Command.NAV_LOITER_TURNS})
+
+
+def _px4(item: WireItem) -> WireItem:
+    """The item as PX4 v1.16 stores it (measured: ``storage_probe.json``)."""
+    if item.frame == PX4_NO_POSITION_FRAME:
+        item = replace(item, x=int(np.float32(item.x)), y=int(np.float32(item.y)))
+    else:
+        item = replace(item, frame=int(_PX4_INT_FRAMES.get(item.frame, item.frame)))
+    if item.command == Command.NAV_TAKEOFF:
+        item = replace(item, param1=0.0)          # the minimum pitch is not kept
+    elif item.command == Command.NAV_WAYPOINT:
+        item = replace(item, param3=0.0)          # the pass radius is not kept
+    return item
+
+
+def px4_refusal(item: WireItem) -> int | None:
+    """The MAV_MISSION_RESULT with which PX4 refuses ``item``, or None if it takes it."""
+    if item.command in PX4_REFUSED_COMMANDS:
+        return UNSUPPORTED
+    if item.frame != PX4_NO_POSITION_FRAME and item.command not in PX4_POSITION_COMMANDS:
+        return UNSUPPORTED
+    return None
 
 
 def stored_item(item: WireItem, autopilot: Autopilot) -> WireItem:
     """What ``autopilot`` returns on download for ``item`` sent to it (``seq`` and
     ``current`` unchanged)."""
-    item = WireItem.normalised(**item.__dict__)       # PX4 keeps what the wire carries
-    return _ardupilot(item) if autopilot == Autopilot.ARDUPILOTMEGA else item
+    item = WireItem.normalised(**item.__dict__)
+    return _ardupilot(item) if autopilot == Autopilot.ARDUPILOTMEGA else _px4(item)
 
 
 def comparable(item: WireItem, autopilot: Autopilot, sent: bool = True) -> WireItem:
     """The item as it must come back from ``autopilot``: a ``sent`` item in its stored form,
-    a downloaded one as it is; on PX4, whose downloads may give a frame in its plain or
-    ``_INT`` form, both with the plain form.  (The stored form is not applied twice: storing
-    truncates, so a download stored again would lose another centimetre.)"""
-    kept = stored_item(item, autopilot) if sent else WireItem.normalised(**item.__dict__)
-    if autopilot == Autopilot.PX4:
-        kept = replace(kept, frame=int(_PX4_FRAMES.get(kept.frame, kept.frame)))
-    return kept
+    a downloaded one as it is.  (The stored form is not applied twice: storing truncates, so
+    a download stored again would lose another centimetre.)"""
+    return stored_item(item, autopilot) if sent else WireItem.normalised(**item.__dict__)
 
 
 def capacity(autopilot: Autopilot) -> int:
@@ -268,6 +301,8 @@ class MissionStore:
                 return UNSUPPORTED
             if item.frame not in MISSION_FRAMES:
                 return UNSUPPORTED_FRAME
+            if self.autopilot == Autopilot.PX4 and px4_refusal(item) is not None:
+                return px4_refusal(item)
         stored = replace(stored_item(item, self.autopilot), current=0)
         if not self.in_place:
             if self._staged is None or item.seq != len(self._staged):
