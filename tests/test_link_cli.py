@@ -7,6 +7,7 @@ import os
 import re
 import subprocess
 import sys
+import threading
 import time
 
 import pytest
@@ -113,14 +114,22 @@ def test_sim_command_runs_as_a_process_and_accepts_uploads(mission, tmp_path):
          "--radius", "80", "--airspeed", "20", "--speedup", "400", "--autostart"],
         stdout=subprocess.PIPE, stderr=subprocess.STDOUT, text=True,
         env={**os.environ, "PYTHONUNBUFFERED": "1"})
+    lines: list[str] = []
+    reader = threading.Thread(target=lambda: lines.extend(iter(process.stdout.readline, "")),
+                              daemon=True)
+    reader.start()
     try:
         time.sleep(1.5)
         result = run("upload", path, "--connect", f"tcp:127.0.0.1:{port}")
         assert result.exit_code == 0, result.output
-        time.sleep(5)      # about 250 s of flight at 400x, and the sim's 0.2 s report cycle
+        deadline = time.monotonic() + 60    # about 250 s of flight at 400x: 1 s unloaded
+        while time.monotonic() < deadline and not any("mission complete" in l for l in lines):
+            time.sleep(0.2)
     finally:
         process.terminate()
-        output, _ = process.communicate(timeout=10)
+        process.wait(timeout=10)
+        reader.join(timeout=10)
+    output = "".join(lines)
     assert f"connect with tcp:127.0.0.1:{port}" in output
     assert f"mission received: {len(to_wire(mission.for_vehicle()))} items" in output
     assert "mission complete" in output
@@ -189,3 +198,27 @@ def test_upload_and_fly_print_one_json_summary(mission, tmp_path, start_vehicle)
     flight = json.loads(result.stdout)["flight"]
     assert result.exit_code == 0 and flight["completed"] and len(flight["targets"]) == 8
     assert "simulated flight completed" in result.stderr
+
+
+def test_upload_of_a_fenced_plan_says_the_fence_and_rally_point_were_not_sent(mission, tmp_path,
+                                                                             start_vehicle):
+    path = tmp_path / "m.fence.plan"
+    exporter_for(path).write(mission, path)
+    vehicle = start_vehicle(mission)
+    result = run("upload", path, "--connect", f"udpout:127.0.0.1:{vehicle.port}")
+    assert result.exit_code == 0, result.output
+    assert "geofence of 1 polygon: NOT sent" in result.output
+    assert "1 rally point: NOT sent" in result.output
+    assert "holds exactly the planned mission items (not what was not sent" in result.output
+
+
+def test_a_waypoints_file_sent_to_px4_is_said_to_be_sent_as_a_px4_mission(mission, tmp_path,
+                                                                          start_vehicle):
+    path = tmp_path / "m.waypoints"
+    exporter_for(path).write(mission, path)
+    vehicle = start_vehicle(mission, autopilot=Autopilot.PX4)
+    result = run("upload", path, "--connect", f"udpout:127.0.0.1:{vehicle.port}")
+    assert result.exit_code == 0, result.output
+    assert "does not say its autopilot" in result.output and "PX4" in result.output
+    assert "(and a home slot if the vehicle is ArduPilot)" in result.output
+    assert vehicle.mission[0].command == 22          # no home slot: take-off first

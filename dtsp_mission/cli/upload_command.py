@@ -19,9 +19,13 @@ def run_upload(mission, connection: str, via: str, verify: bool, signing_key_fil
     key = read_signing_key(signing_key_file) if signing_key_file else None
     progress, close = progress_reporter("uploading")
     slots = len(to_wire(mission))
-    home = " and the home slot" if slots > len(mission.items) else ""
-    say(f"uploading {len(mission.items)} mission items{home} ({slots} mission slots) to "
-               f"{connection} via {via}")
+    if not mission.autopilot_stated:      # the vehicle's autopilot decides the home slot
+        what = f"{len(mission.items)} mission items (and a home slot if the vehicle is ArduPilot)"
+    elif slots > len(mission.items):
+        what = f"{len(mission.items)} mission items and the home slot ({slots} mission slots)"
+    else:
+        what = f"{len(mission.items)} mission items ({slots} mission slots)"
+    say(f"uploading {what} to {connection} via {via}")
     try:
         report = upload_mission(mission, connection, via=via, verify=verify, signing_key=key,
                                 progress=progress, heartbeat_timeout_s=heartbeat_timeout_s,
@@ -33,8 +37,11 @@ def run_upload(mission, connection: str, via: str, verify: bool, signing_key_fil
     fresh = f", {report.fresh_starts} fresh starts" if report.fresh_starts else ""
     line = (f"the vehicle accepted {report.items} mission slots in {report.seconds:.2f} s "
             f"({report.resent} messages resent{fresh})")
-    say(line + ("; downloaded back: it holds exactly the planned mission" if report.verified
-                       else "; not verified (--no-verify)"))
+    held = ("exactly the planned mission" if not mission.not_carried else
+            "exactly the planned mission items (not what was not sent: "
+            + ", ".join(mission.not_carried) + ")")
+    say(line + (f"; downloaded back: it holds {held}" if report.verified
+                else "; not verified (--no-verify)"))
     if report.note:
         note(report.note)
     record(upload={"via": report.via, "mission_slots": report.items, "seconds": report.seconds,

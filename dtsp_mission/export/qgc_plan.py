@@ -151,6 +151,17 @@ def _item_violations(item: Any) -> list[str]:
     return problems
 
 
+def _beside_the_items(data: dict) -> tuple[str, ...]:
+    """What a (checked) plan holds beside its mission items: geofence shapes, rally points."""
+    fence, rally = data["geoFence"], data["rallyPoints"]["points"]
+    shapes = [f"{len(fence[key])} {key[:-1] if len(fence[key]) == 1 else key}"
+              for key in ("polygons", "circles") if fence[key]]
+    held = [f"a geofence of {' and '.join(shapes)}"] if shapes else []
+    if rally:
+        held.append(f"{len(rally)} rally point{'s' if len(rally) > 1 else ''}")
+    return tuple(held)
+
+
 class QGCPlanExporter(Exporter):
     """QGroundControl plan (``.plan``)."""
 
@@ -199,7 +210,7 @@ class QGCPlanExporter(Exporter):
         if isinstance(wind, dict) and all(_is_number(wind.get(k)) for k in ("speed_m_s", "from_deg")):
             design_wind = (float(wind["speed_m_s"]), float(wind["from_deg"]))
         read = VehicleMission(tuple(items), Home(*mission["plannedHomePosition"]), autopilot,
-                              design_wind=design_wind)
+                              design_wind=design_wind, not_carried=_beside_the_items(data))
         problems = read.problems()
         if problems:
             raise FileFormatError(f"{path}: " + "; ".join(problems[:3]))

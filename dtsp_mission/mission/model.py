@@ -65,6 +65,9 @@ _POSITIONLESS_FRAMES = {2}      # MAV_FRAME_MISSION: x and y are parameters, not
 _ABOVE_HOME_FRAMES = {3, 6, 10, 11}
 
 
+_FLOAT32_MAX = 3.4028234663852886e38
+
+
 @dataclass(frozen=True)
 class VehicleMission:
     """What a vehicle receives: the items, the home they are relative to, and the autopilot
@@ -81,12 +84,26 @@ class VehicleMission:
     autopilot_stated: bool = True
     #: the wind the mission was designed for: (m/s, degrees true it comes from); None: unknown
     design_wind: tuple[float, float] | None = None
+    #: what the file holds beside the mission items, which an upload of the items does not
+    #: carry ("a geofence of 1 polygon", "1 rally point")
+    not_carried: tuple[str, ...] = ()
 
     def problems(self) -> list[str]:
         """What no autopilot would take, or no operator would fly, from this mission: a home or
         an item position off the globe (MAVLink's int32 degrees x 1e7 cannot even carry it) or
-        not a number; a navigation item (other than a landing) below home or the terrain."""
+        not a number; a navigation item (other than a landing) below home or the terrain; a
+        command, frame or value that MISSION_ITEM_INT cannot carry (command 16 bits, frame 8,
+        parameters and altitude 32-bit floats)."""
         found = []
+        for number, item in enumerate(self.items, start=1):
+            values = (*item.params, item.altitude_m)
+            if not (0 <= int(item.command) <= 0xFFFF and 0 <= int(item.frame) <= 0xFF):
+                found.append(f"item {number}: command {int(item.command)} / frame "
+                             f"{int(item.frame)} is not a MAVLink command / frame number")
+            elif any(abs(v) > _FLOAT32_MAX for v in values):      # NaN passes: PX4's "unset"
+                found.append(f"item {number} (command {int(item.command)}): a parameter or the "
+                             "altitude is beyond what MAVLink carries (32-bit floats, "
+                             f"at most {_FLOAT32_MAX:.3g})")
         if not (-90 <= self.home.latitude_deg <= 90 and -180 <= self.home.longitude_deg <= 180):
             found.append(f"home ({self.home.latitude_deg:g}, {self.home.longitude_deg:g}) is not "
                          "a latitude and longitude in degrees")

@@ -15,7 +15,7 @@ from dataclasses import dataclass, replace
 from ..autopilot import MAVLINK_MAX_ITEMS, Autopilot
 from ..autopilot.parameters import ARDUPLANE_DEFAULTS, NAMES, VehicleParameters, parameters_from
 from ..errors import InputError, LinkError
-from ..mission import VehicleMission
+from ..mission import Command, VehicleMission
 from ..plugins import load_group, working
 from .base import VEHICLE_GIVES_UP_S, Progress, Uploader, VehicleInfo
 from .wire import WireItem, describe_vehicle, differences, to_wire
@@ -109,6 +109,16 @@ def vehicle_warnings(mission: VehicleMission, info: VehicleInfo,
     return warnings
 
 
+def _unstated_for_px4(mission: VehicleMission) -> str:
+    """The warning for a mission file that does not say its autopilot, sent to a PX4."""
+    ends = ""
+    if mission.items and mission.items[-1].command == Command.NAV_RETURN_TO_LAUNCH:
+        ends = (": it ends in a return to launch, which PX4 flies by its own RTL_TYPE and "
+                "RTL_RETURN_ALT (not ArduPlane's RTL_ALTITUDE and loiter); check them")
+    return ("the file does not say its autopilot (QGC WPL 110 is ArduPilot's format) and was "
+            "sent as a PX4 mission" + (ends or "; check it was designed for PX4"))
+
+
 def upload_mission(mission: VehicleMission, connection: str, via: str = "pymavlink",
                    verify: bool = True, signing_key: bytes | None = None,
                    progress: Progress | None = None,
@@ -142,11 +152,16 @@ def upload_mission(mission: VehicleMission, connection: str, via: str = "pymavli
         names = NAMES if mission.autopilot == Autopilot.ARDUPILOTMEGA else ()
         info = uploader.vehicle_info(names, WIND_WAIT_S if mission.design_wind is not None
                                      and mission.autopilot == Autopilot.ARDUPILOTMEGA else 0.0)
+        unstated = []
         if not mission.autopilot_stated and info.autopilot in _AUTOPILOT_NAMES:
             # A .waypoints file does not say its autopilot: it is meant for this vehicle's.
             mission = replace(mission, autopilot=Autopilot(info.autopilot), autopilot_stated=True)
             wire = to_wire(mission)
-        warnings = tuple(vehicle_warnings(mission, info, designed_for))
+            if mission.autopilot == Autopilot.PX4:
+                unstated.append(_unstated_for_px4(mission))
+        warnings = tuple(unstated + vehicle_warnings(mission, info, designed_for)
+                         + [f"the file also holds {what}: NOT sent (this uploads mission items "
+                            "only; send it with QGroundControl)" for what in mission.not_carried])
         transfer_started = time.perf_counter()
         try:
             uploader.upload(wire, progress)
