@@ -161,3 +161,88 @@ def test_plan_upload_to_nothing_leaves_no_file(tmp_path):
                  "--plot", tmp_path / "o.png", "--upload", f"tcp:127.0.0.1:{port}")
     assert result.returncode != 0 and "Traceback" not in result.stderr, result.stderr
     assert sorted(p.name for p in tmp_path.iterdir()) == ["t.csv"]
+
+
+SMALL = "lat,lon\n46.80,6.95\n46.81,6.96\n46.805,6.97\n"
+
+
+def _small(tmp_path: Path, text: str = SMALL) -> Path:
+    (tmp_path / "t.csv").write_text(text)
+    return tmp_path / "t.csv"
+
+
+def test_an_altitude_below_the_floor_is_refused_and_can_be_lowered_explicitly(tmp_path):
+    refused(run("plan", _small(tmp_path), "--radius", 80, "--time-limit", 1, "--alt", 0.5,
+                "-o", tmp_path / "a.json"), "--min-alt")
+    lowered = run("plan", _small(tmp_path), "--radius", 80, "--time-limit", 1, "--alt", 20,
+                  "--min-alt", 10, "--design", "geometry", "-o", tmp_path / "b.json")
+    assert lowered.returncode == 0, lowered.stderr
+    assert not (tmp_path / "a.json").exists()
+
+
+def test_a_target_altitude_below_the_floor_is_refused_before_planning_naming_its_line(tmp_path):
+    text = "lat,lon,alt\n46.80,6.95,90\n46.81,6.96,0.001\n46.805,6.97,90\n"
+    refused(run("plan", _small(tmp_path, text), "--radius", 80, "--time-limit", 1,
+                "-o", tmp_path / "a.json"), "line 3", "--min-alt")
+
+
+def test_a_step_steeper_than_the_aircraft_climbs_is_a_warning(tmp_path):
+    text = "lat,lon,alt\n46.80,6.95,40\n46.8015,6.95,300\n46.805,6.97,40\n"
+    result = run("plan", _small(tmp_path, text), "--radius", 80, "--time-limit", 1,
+                 "--design", "geometry", "-o", tmp_path / "a.plan")
+    assert result.returncode == 0, result.stderr
+    assert "steeper than" in result.stderr, result.stderr
+
+
+def test_a_negative_relative_altitude_in_a_plan_is_refused(tmp_path):
+    def sunk(document):
+        document["mission"]["items"][2]["params"][6] = -20
+    refused(run("fly", _plan_variant(tmp_path, "sunk.plan", sunk), "--speedup", 0),
+            "below the ground")
+
+
+@pytest.mark.parametrize("option,value,words", [
+    ("--max-items", 3, ["for the target(s)"]),
+    ("--endurance", 0.01, ["--endurance"]),
+])
+def test_capacity_messages_say_what_is_needed(tmp_path, option, value, words):
+    result = run("plan", _small(tmp_path), "--radius", 80, "--time-limit", 1, option, value,
+                 "-o", tmp_path / "a.plan")
+    refused(result, *words)
+    assert "None" not in result.stderr
+
+
+def test_a_port_out_of_range_is_named(tmp_path):
+    refused(run("upload", _plan_variant(tmp_path, "p.plan", lambda d: None),
+                "--connect", "tcp:127.0.0.1:99999"), "99999 is not a port number")
+
+
+def test_upload_names_only_the_formats_it_reads(tmp_path):
+    result = run("upload", _small(tmp_path), "--connect", "tcp:127.0.0.1:5799")
+    refused(result, ".waypoints")
+    assert ".geojson" not in result.stderr and ".kml" not in result.stderr
+
+
+def test_dubins_takes_negative_poses_without_a_separator():
+    result = run("dubins", "-5,0,0", "100,20,90", "--radius", 10)
+    assert result.returncode == 0, result.stderr
+
+
+def test_fly_refuses_targets_far_from_the_mission_and_shows_unknown_altitude(tmp_path):
+    plan = _plan_variant(tmp_path, "f.plan", lambda d: None)
+    (tmp_path / "far.csv").write_text("lat,lon\n10.0,10.0\n")
+    refused(run("fly", plan, "--speedup", 0, "--targets", tmp_path / "far.csv"), "--targets")
+    result = run("fly", plan, "--speedup", 0, "--targets", tmp_path / "t.csv")
+    assert result.returncode == 0, result.stderr
+    assert "nan" not in result.stdout.lower(), result.stdout
+    assert "flying about" in result.stdout         # the estimate, said before flying
+
+
+def test_random_targets_in_an_area_smaller_than_a_turn_are_refused(tmp_path):
+    ring = [[6.95, 46.8], [6.9500001, 46.8], [6.9500001, 46.8000001], [6.95, 46.8000001],
+            [6.95, 46.8]]
+    (tmp_path / "tiny.geojson").write_text(json.dumps({"type": "FeatureCollection", "features": [
+        {"type": "Feature", "properties": {}, "geometry": {"type": "Polygon",
+                                                           "coordinates": [ring]}}]}))
+    refused(run("plan", "--random", 8, "--area", tmp_path / "tiny.geojson", "--radius", 80,
+                "-o", tmp_path / "r.json"), "smaller than one turn")

@@ -7,7 +7,8 @@ import click
 import numpy as np
 
 from ..autopilot.navigation import CALM, check_wind
-from ..sim.fly import FlightCheck, check_targets_near, fly_mission, targets_from, targets_in
+from ..sim.fly import (FlightCheck, check_targets_near, estimated_flight_m, fly_mission,
+                       targets_from, targets_in)
 from . import console
 from .console import console_options, note, record, say
 from .options import (UserError, apply, progress_reporter, reports_errors, simulation_options,
@@ -20,6 +21,7 @@ def run_flight_check(mission, targets, airframe, via: str, speedup: float,
                      wind=None) -> FlightCheck:
     """Fly, print the report, and fail (exit 1) when ``max_miss_m`` is exceeded (shared with
     ``plan --simulate``)."""
+    _say_estimate(mission, airframe, speedup)
     progress, close = progress_reporter("flying")
     try:
         check = fly_mission(mission, targets, airframe, via=via, speedup=speedup, max_items=max_items,
@@ -33,6 +35,22 @@ def run_flight_check(mission, targets, airframe, via: str, speedup: float,
         raise click.ClickException(f"a target was missed by {check.max_miss_m:.1f} m, more than "
                                    f"--max-miss {max_miss_m:g} m")
     return check
+
+
+def _say_estimate(mission, airframe, speedup: float) -> None:
+    """Say up front how long the flight will take (flight time, and the wait at ``speedup``)."""
+    length = estimated_flight_m(mission, airframe.loiter_radius_m)
+    flight_s = length / airframe.airspeed_m_s
+    wait = (f"about {_duration(flight_s / speedup)} to simulate at --speedup {speedup:g}"
+            if speedup > 0 else "simulated as fast as it computes")
+    say(f"flying about {length / 1000:,.1f} km, {_duration(flight_s)} of flight; {wait}")
+
+
+def _duration(seconds: float) -> str:
+    if seconds < 90:
+        return f"{seconds:.0f} s"
+    minutes = int(round(seconds / 60))
+    return f"{minutes // 60} h {minutes % 60:02d} min" if minutes >= 60 else f"{minutes} min"
 
 
 def print_check(check: FlightCheck) -> None:

@@ -22,6 +22,7 @@ from ..planning.base import MERGE_RESOLUTION_RHO
 from ..planning.rbta import region_heading_deg
 from ..plot import plot_format, render_plan, require_matplotlib
 from ..targets import GeoTargets, Targets, random_targets, read_targets
+from ..targets.random_area import check_random_area
 from ..targets.actions import TargetActions, check_loiter_turns
 from ..targets.geojson_file import read_geojson
 from . import console
@@ -53,7 +54,7 @@ def _check_writable(paths) -> None:
 
 
 def _targets(targets_file: str | None, random_count: int | None, area_file: str | None,
-             seed: int) -> GeoTargets | Targets:
+             seed: int, rho_m: float) -> GeoTargets | Targets:
     if random_count is not None and targets_file is not None and area_file is not None:
         raise UserError(f"give either a TARGETS_FILE ({targets_file}) or --random N with --area, "
                         "not both: --random draws its own targets")
@@ -73,6 +74,7 @@ def _targets(targets_file: str | None, random_count: int | None, area_file: str 
         raise UserError(f"{area_file or targets_file}: no Polygon feature to draw --random targets in")
     if len(source) and area_file is None:
         raise UserError(f"{targets_file} holds targets; --random draws its own (use --area)")
+    check_random_area(source.area_deg, rho_m, f"--area {area_file or targets_file}")
     return random_targets(source.area_deg, random_count, seed)
 
 
@@ -178,7 +180,7 @@ def plan(targets_file, random_count, area_file, seed, origin, rho_m, airspeed_m_
     rho, rho_source = turn_radius_from(rho_m, airspeed_m_s, max_bank_deg,
                                        designed_for.ROLL_LIMIT_DEG if designed_for else None)
     check_radius(rho)
-    targets = _targets(targets_file, random_count, area_file, seed)
+    targets = _targets(targets_file, random_count, area_file, seed, rho)
     if len(targets) < 2:
         raise UserError(f"{targets_file or 'the input'} holds {len(targets)} target(s) after "
                         "merging duplicates; a tour needs at least 2 (for one point, fly a "

@@ -383,9 +383,11 @@ def check_altitude_floor(targets: GeoTargets, settings: MissionSettings) -> None
 
 
 def _target_label(targets: GeoTargets, index: int) -> str:
-    """How a message names target ``index`` (input order): its name, or its number."""
+    """How a message names target ``index`` (input order): the row of its file ("line 7"),
+    else its number; with its name where it has one."""
     name = targets.names[index] if targets.names else ""
-    return f"target {index + 1} ({name})" if name else f"target {index + 1}"
+    label = targets.rows[index] if targets.rows else f"target {index + 1}"
+    return f"{label} ({name})" if name else label
 
 
 def _steep_steps(path: FlightPath, targets: GeoTargets, settings: MissionSettings) -> list[str]:

@@ -63,14 +63,37 @@ def targets_from(geodetic) -> Targets:
 FAR_FROM_MISSION_M = 5_000.0
 
 
-def check_targets_near(mission: VehicleMission, targets: Targets, where: str) -> None:
-    """:class:`InputError` when a target is more than :data:`FAR_FROM_MISSION_M` from every
-    position of the mission (its home and items): they are not this mission's targets."""
+def mission_places_m(mission: VehicleMission) -> tuple[np.ndarray, list]:
+    """The mission's home (row 0) and its positioned items, in the local frame around home;
+    and those items."""
     frame = LocalFrame(mission.home.latitude_deg, mission.home.longitude_deg)
     positioned = [i for i in mission.items if i.has_position]
     places = np.vstack([np.zeros((1, 2))] + ([frame.to_local([i.latitude_deg for i in positioned],
                                                              [i.longitude_deg for i in positioned])]
                                              if positioned else []))
+    return places, positioned
+
+
+def estimated_flight_m(mission: VehicleMission, loiter_radius_m: float) -> float:
+    """A quick estimate of the flight's length for a progress message (not a prediction):
+    straight legs from home through the positioned items, the loiter circles' turns
+    (``loiter_radius_m`` where an item gives none), and the way back home after a return."""
+    places, positioned = mission_places_m(mission)
+    length = float(np.hypot(*np.diff(places, axis=0).T).sum())
+    for item in positioned:
+        if item.command == Command.NAV_LOITER_TURNS:
+            radius = abs(item.params[2]) or loiter_radius_m
+            length += 2.0 * math.pi * radius * max(1.0, float(item.params[0]))
+    if mission.items and mission.items[-1].command == Command.NAV_RETURN_TO_LAUNCH:
+        length += float(np.hypot(*places[-1]))
+    return length
+
+
+def check_targets_near(mission: VehicleMission, targets: Targets, where: str) -> None:
+    """:class:`InputError` when a target is more than :data:`FAR_FROM_MISSION_M` from every
+    position of the mission (its home and items): they are not this mission's targets."""
+    places, _ = mission_places_m(mission)
+    frame = LocalFrame(mission.home.latitude_deg, mission.home.longitude_deg)
     points = frame.to_local(targets.latitudes_deg, targets.longitudes_deg)
     gaps = np.array([np.hypot(*(places - point).T).min() for point in points])
     if len(gaps) and gaps.max() > FAR_FROM_MISSION_M:

@@ -56,6 +56,7 @@ class GeoTargets:
     area_deg: np.ndarray | None = None
     unused_columns: tuple[str, ...] = ()       # columns of the file that were not used
     actions: TargetActions | None = None       # what to do at each target (None: overfly)
+    rows: tuple[str, ...] | None = None        # where each target came from ("line 7")
 
     def __post_init__(self) -> None:
         """Raise :class:`InputError` (a message for a caller of the API, naming no command-line
@@ -69,7 +70,7 @@ class GeoTargets:
         from ..frame import check_geodetic
         check_geodetic(latitudes, longitudes)
         for label, values in (("names", self.names), ("altitudes", self.altitudes_m),
-                              ("actions", self.actions)):
+                              ("actions", self.actions), ("rows", self.rows)):
             if values is not None and len(values) != len(latitudes):
                 raise InputError(f"GeoTargets has {len(latitudes)} targets but {len(values)} {label}")
         object.__setattr__(self, "latitudes_deg", latitudes)
@@ -93,7 +94,7 @@ class GeoTargets:
         return replace(self, latitudes_deg=self.latitudes_deg[keep],
                        longitudes_deg=self.longitudes_deg[keep], names=_pick(self.names, keep),
                        altitudes_m=_pick(self.altitudes_m, keep), merged_duplicates=0,
-                       actions=_pick(self.actions, keep))
+                       actions=_pick(self.actions, keep), rows=_pick(self.rows, keep))
 
 
 #: The highest altitude above home a target or mission may use: beyond it a number is far more
@@ -217,4 +218,5 @@ def geodetic_targets(latitudes_deg: np.ndarray, longitudes_deg: np.ndarray, name
     keep, merged = _merged(np.column_stack([latitudes, longitudes]), names, altitudes_m, actions,
                            where, rows)
     return GeoTargets(latitudes[keep], longitudes[keep], _pick(names, keep), merged,
-                      _pick(altitudes_m, keep), area_deg, actions=_pick(actions, keep))
+                      _pick(altitudes_m, keep), area_deg, actions=_pick(actions, keep),
+                      rows=_pick(tuple(rows), keep) if rows is not None else None)

@@ -65,7 +65,7 @@ def test_px4_falls_back_to_the_geometric_design_and_says_so():
 
 def test_a_budget_below_one_item_per_target_is_refused_with_the_count():
     tour, frame, targets = sparse_site(30)
-    with pytest.raises(InputError, match=r"needs at least 3\d items \(one per target\)"):
+    with pytest.raises(InputError, match=r"needs at least 33 items \(30 for the target\(s\), one each"):
         build_mission(tour, frame, targets, MissionSettings(design="guidance", max_items=20))
 
 
