@@ -6,7 +6,9 @@ written over something that is not a regular file."""
 from __future__ import annotations
 
 import json
+import math
 import os
+import re
 import subprocess
 import sys
 from pathlib import Path
@@ -246,3 +248,17 @@ def test_random_targets_in_an_area_smaller_than_a_turn_are_refused(tmp_path):
                                                            "coordinates": [ring]}}]}))
     refused(run("plan", "--random", 8, "--area", tmp_path / "tiny.geojson", "--radius", 80,
                 "-o", tmp_path / "r.json"), "smaller than one turn")
+
+
+def test_many_loiter_turns_are_designed_in_seconds_and_counted_in_the_flight(tmp_path):
+    """255 turns at each of 6 targets: a 1,000 km flight.  The design flies the first turns
+    of each loiter (the rest repeat them) and adds the rest's length; fly says what it faces."""
+    text = "lat,lon,loiter_turns\n" + "".join(
+        f"{46.80 + 0.005 * (k % 3)},{6.95 + 0.01 * (k // 3) + 0.004 * k},255\n" for k in range(6))
+    result = run("plan", _small(tmp_path, text), "--radius", 80, "--time-limit", 1,
+                 "-o", tmp_path / "l.plan")
+    assert result.returncode == 0, result.stderr
+    found = re.search(r"predicted flight ([\d,.]+) km against ([\d,.]+) km", result.stdout)
+    predicted, planned = (float(g.replace(",", "")) for g in found.groups())
+    assert predicted > 6 * 255 * 2 * math.pi * 80 / 1000        # every turn counted
+    assert abs(predicted / planned - 1) < 0.05, result.stdout

@@ -143,6 +143,8 @@ def _fly(items: list[LocalItem], airframe: Airframe, heading_rad: float, stop_af
     return track, dict(flight.reached), run.closest_m, run.measured_length_m
 
 
+#: Turns of a loiter the design flies: the later ones repeat the last (their length is added).
+DESIGN_LOITER_TURNS = 2
 #: The first item after the take-off (seq 1): the misses and length count from it.
 _AFTER_TAKEOFF = 2
 #: No predicted flight goes on longer than this (s).
@@ -491,9 +493,16 @@ def design_waypoints(path: FlightPath, targets_m: np.ndarray, altitudes_m: np.nd
     takeoff = path.chain.pose_at(np.array([0.0]))[0, :2] - home
     heading = math.atan2(takeoff[1], takeoff[0])
     lookback_m = LOOKBACK_L1 * airframe.l1_distance_m(airframe.airspeed_m_s)
+    # The design flies each loiter's first DESIGN_LOITER_TURNS turns: later turns repeat the
+    # last one (same circle, same exit), so they add their length and change no miss.
     loiters = {span.target: (float(span.centre_m[0] - home[0]), float(span.centre_m[1] - home[1]),
-                             loiter_turns_params(span.turns, span.radius_m, span.clockwise))
+                             loiter_turns_params(min(span.turns, DESIGN_LOITER_TURNS),
+                                                 span.radius_m, span.clockwise))
                for span in path.loiters}
+    # The flights end with the last target's loiter, if it has one: so does the plan compared.
+    planned_end_s = max([float(path.target_s_m.max())] + [span.end_s_m for span in path.loiters])
+    skipped_m = sum(2.0 * math.pi * span.radius_m * max(span.turns - DESIGN_LOITER_TURNS, 0)
+                    for span in path.loiters)
     loiter_ends = {float(span.start_s_m): float(span.end_s_m) for span in path.loiters}
     takeoff_alt = float(path.altitude_m(np.array([0.0]))[0])
     rounds = ROUNDS if rounds is None else rounds
@@ -517,8 +526,8 @@ def design_waypoints(path: FlightPath, targets_m: np.ndarray, altitudes_m: np.nd
         flown = track[:, 1:] + home
         after_takeoff = track[:, 0] >= reached.get(1, 0.0)
         start_s = reached.get(1, 0.0)
-        design = GuidanceDesign(np.asarray(s_wp), aim, np.asarray(target_of), miss, predicted,
-                                float(path.target_s_m.max()), flights)
+        design = GuidanceDesign(np.asarray(s_wp), aim, np.asarray(target_of), miss,
+                                predicted + skipped_m, planned_end_s, flights)
         corrections = {}
         for k, t in enumerate(target_of):       # the track near each target's own leg
             if t < 0 or miss[t] <= CORRECT_ABOVE * repair_miss_m:
@@ -588,6 +597,6 @@ def design_waypoints(path: FlightPath, targets_m: np.ndarray, altitudes_m: np.nd
         lambda wind: MissionFlight(final, airframe, heading, 1, wind).run(
             VERIFY_STEP_S, len(final) - 2, points_m=targets_m - home, track=False,
             measure_from_seq=_AFTER_TAKEOFF, until_s=FLIGHT_LIMIT_S), winds)]
-    return GuidanceDesign(design.s_m, aim, design.target_of, misses[0], length,
+    return GuidanceDesign(design.s_m, aim, design.target_of, misses[0], length + skipped_m,
                           design.planned_length_m, flights + len(winds),
                           _judged(misses, spread_margin_m), np.max(misses, axis=0))
