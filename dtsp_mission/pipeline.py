@@ -31,6 +31,10 @@ from .targets import GeoTargets, Targets
 from .tour import Tour
 
 
+#: What becomes of a mission too large for the vehicle (:attr:`PlanRequest.too_large`).
+TOO_LARGE = ("split", "raise", "note")
+
+
 @dataclass(frozen=True)
 class PlanRequest:
     """What to plan.
@@ -54,6 +58,13 @@ class PlanRequest:
     settings: MissionSettings | None = None
     too_large: str = "split"
     endurance_s: float | None = None
+
+    def __post_init__(self) -> None:
+        """:class:`InputError` for a ``too_large`` that is none of its three values (a typo
+        would otherwise mean "split")."""
+        if self.too_large not in TOO_LARGE:
+            raise InputError(f"PlanRequest.too_large must be one of {', '.join(TOO_LARGE)}, "
+                             f"got {self.too_large!r}")
 
 
 @dataclass

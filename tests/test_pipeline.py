@@ -85,3 +85,8 @@ def test_the_guidance_design_reports_its_progress_in_order():
     assert result.mission is not None and tour_steps and design_steps
     assert design_steps == sorted(design_steps) and 0.0 < design_steps[0] and design_steps[-1] <= 1.0
     assert result.mission.summary["design_rounds"] >= 1
+
+
+def test_a_plan_request_refuses_an_unknown_too_large():
+    with pytest.raises(InputError, match="too_large must be one of split, raise, note"):
+        PlanRequest(local_targets(np.array([[0.0, 0.0], [500.0, 0.0]])), 80.0, too_large="spilt")

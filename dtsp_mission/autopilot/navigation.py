@@ -41,6 +41,8 @@ SITL_TURN_EFFICIENCY = 0.73
 #: The time step the model's agreement with recorded ArduPlane flights was measured at
 #: (docs/arduplane-agreement.md): the flight that predicts, verifies and simulates a mission.
 MODEL_STEP_S = 0.02
+#: No predicted flight goes on longer than this (s): the design's and the offline prediction's cap.
+FLIGHT_LIMIT_S = 36000.0
 #: The take-off run of ArduPlane SITL's stock plane (fitted to the recorded climbs: 43 m run
 #: in the first 4 s, lift-off at 85 % of the cruise airspeed after about 3.5 s).
 TAKEOFF_ACCEL_M_S2 = 5.3

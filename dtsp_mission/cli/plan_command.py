@@ -22,6 +22,7 @@ from ..planning.base import MERGE_RESOLUTION_RHO
 from ..planning.rbta import region_heading_deg
 from ..plot import plot_format, render_plan, require_matplotlib
 from ..targets import GeoTargets, Targets, random_targets, read_targets
+from ..targets.model import target_name
 from ..targets.random_area import check_random_area
 from ..targets.actions import TargetActions, check_loiter_turns
 from ..targets.geojson_file import read_geojson
@@ -345,7 +346,7 @@ def _report_sorties(result: PlanResult, max_miss_m: float) -> None:
     for k, sortie in enumerate(sorties):
         summary = sortie.mission.summary
         first, last = sortie.targets[0], sortie.targets[-1]
-        label = (lambda i: names[i] if names else f"target {i + 1}")
+        label = (lambda i: target_name(names, i))
         time_text = (f", {_duration(summary['flight_time_s'])}" if "flight_time_s" in summary
                      else "")
         beyond = targets_beyond(sortie.mission)

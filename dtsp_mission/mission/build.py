@@ -20,7 +20,7 @@ from ..errors import DtspError, InputError, MissionTooLarge
 from ..frame import LocalFrame
 from ..targets import GeoTargets
 from ..targets.actions import TargetActions, check_gimbal_pitch
-from ..targets.model import MAX_ALTITUDE_M
+from ..targets.model import MAX_ALTITUDE_M, target_name
 from ..tour import Tour
 from ..vehicle import bearing_to_heading_rad, heading_to_bearing_deg
 from ..autopilot.commands import AUTOPILOTS, Command, Frame
@@ -386,7 +386,7 @@ def _target_label(targets: GeoTargets, index: int) -> str:
     """How a message names target ``index`` (input order): the row of its file ("line 7"),
     else its number; with its name where it has one."""
     name = targets.names[index] if targets.names else ""
-    label = targets.rows[index] if targets.rows else f"target {index + 1}"
+    label = target_name(targets.rows, index)
     return f"{label} ({name})" if name else label
 
 
@@ -451,9 +451,9 @@ def build_mission(tour: Tour, frame: LocalFrame, targets: GeoTargets,
         judged = design.judged_miss_m
         held = judged <= settings.design_limit_m
         if not held.all():
-            names = targets.names or tuple(f"target {i + 1}" for i in range(len(held)))
             worst = np.argsort(-judged)[: int((~held).sum())]
-            listed = ", ".join(f"{names[i]} ({judged[i]:.1f} m)" for i in worst[:8])
+            listed = ", ".join(f"{target_name(targets.names, i)} ({judged[i]:.1f} m)"
+                               for i in worst[:8])
             more = f" and {len(worst) - 8} more" if len(worst) > 8 else ""
             notes.append(f"{int((~held).sum())} of {len(held)} targets are predicted beyond "
                          f"{settings.design_limit_m:g} m (--max-miss {settings.max_miss_m:g} m "

@@ -56,7 +56,7 @@ from typing import Callable
 import numpy as np
 
 from ..autopilot.commands import Command
-from ..autopilot.navigation import (CALM, MODEL_STEP_S, Airframe, LocalItem, MissionArrays,
+from ..autopilot.navigation import (CALM, FLIGHT_LIMIT_S, MODEL_STEP_S, Airframe, LocalItem, MissionArrays,
                                     MissionFlight, Wind)
 from .actions import loiter_turns_params
 from .model import FlightPath
@@ -147,8 +147,6 @@ def _fly(items: list[LocalItem], airframe: Airframe, heading_rad: float, stop_af
 DESIGN_LOITER_TURNS = 2
 #: The first item after the take-off (seq 1): the misses and length count from it.
 _AFTER_TAKEOFF = 2
-#: No predicted flight goes on longer than this (s).
-FLIGHT_LIMIT_S = 36000.0
 
 
 def _nearest_in(track_xy: np.ndarray, point: np.ndarray) -> np.ndarray:

@@ -19,6 +19,7 @@ from pymavlink import mavutil
 
 from ..errors import InputError, LinkError
 from ..frame import LocalFrame
+from ..targets.model import target_name
 from ..mission import Command, VehicleMission
 from ..upload import UploadReport, upload_mission
 from ..upload.pymavlink_link import GCS_COMPONENT_ID, GCS_SYSTEM_ID, use_mavlink2
@@ -45,7 +46,7 @@ def planned_targets(mission) -> Targets:
     index = np.array([item.target for item in chosen], dtype=np.int64)
     names = mission.target_names
     return Targets(latitudes[index], longitudes[index], np.array([i.altitude_m for i in chosen]),
-                   tuple(names[i] if names else f"target {i + 1}" for i in index))
+                   tuple(target_name(names, i) for i in index))
 
 
 def targets_from(geodetic) -> Targets:
@@ -54,7 +55,7 @@ def targets_from(geodetic) -> Targets:
     count = len(geodetic)
     altitudes = (np.full(count, np.nan) if geodetic.altitudes_m is None
                  else np.asarray(geodetic.altitudes_m, dtype=float))
-    names = geodetic.names or tuple(f"target {i + 1}" for i in range(count))
+    names = tuple(target_name(geodetic.names, i) for i in range(count))
     return Targets(np.asarray(geodetic.latitudes_deg), np.asarray(geodetic.longitudes_deg),
                    altitudes, tuple(names))
 
@@ -109,7 +110,7 @@ def targets_in(mission: VehicleMission, names: tuple[str, ...] | None = None) ->
     NAV_WAYPOINT with an acceptance radius (how dtsp-mission writes targets)."""
     chosen = [item for item in mission.items if item.role == "target"]
     if chosen:
-        labels = tuple(names[i.target] if names else f"target {i.target + 1}" for i in chosen)
+        labels = tuple(target_name(names, i.target) for i in chosen)
     else:
         numbered = [(seq, item) for seq, item in enumerate(mission.items, start=1)
                     if item.command == Command.NAV_WAYPOINT and item.params[1] > 0]

@@ -13,7 +13,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from ..autopilot import Command, stored_item
-from ..autopilot.navigation import (CALM, MODEL_STEP_S, Airframe, LocalItem, MissionFlight, Wind,
+from ..autopilot.navigation import (CALM, FLIGHT_LIMIT_S, MODEL_STEP_S, Airframe, LocalItem, MissionFlight, Wind,
                                     local_items)
 from ..frame import LocalFrame
 from ..mission import VehicleMission
@@ -34,7 +34,7 @@ class PredictedFlight:
 
 
 def predict_flight(mission: VehicleMission, airframe: Airframe, dt_s: float = MODEL_STEP_S,
-                   after_last_s: float = 0.0, limit_s: float = 36000.0,
+                   after_last_s: float = 0.0, limit_s: float = FLIGHT_LIMIT_S,
                    wind: Wind = CALM) -> PredictedFlight:
     """Fly ``mission`` in ``wind`` until its last waypoint or loiter is reached, then
     ``after_last_s`` more (in RTL, as ArduPlane goes on after a mission without one)."""

@@ -97,6 +97,11 @@ class GeoTargets:
                        actions=_pick(self.actions, keep), rows=_pick(self.rows, keep))
 
 
+def target_name(names: Sequence[str] | None, index: int) -> str:
+    """How the product names target ``index`` (input order): its name, else "target N"."""
+    return names[index] if names else f"target {index + 1}"
+
+
 #: The highest altitude above home a target or mission may use: beyond it a number is far more
 #: likely a typo (or feet) than a fixed-wing survey.
 MAX_ALTITUDE_M = 10_000.0
@@ -113,7 +118,7 @@ def check_altitudes(altitudes_m: np.ndarray | None, where: str,
     bad = given & (~np.isfinite(altitudes_m) | (altitudes_m <= 0.0) | (altitudes_m > MAX_ALTITUDE_M))
     if bad.any():
         index = int(np.argmax(bad))
-        row = rows[index] if rows is not None else f"target {index + 1}"
+        row = target_name(rows, index)
         raise InputError(f"{where}, {row}: altitude {float(altitudes_m[index])!r} m must be "
                          f"a number above 0 and at most {MAX_ALTITUDE_M:,.0f} (metres above home)")
 
@@ -140,8 +145,7 @@ def check_conflicts(leader: np.ndarray, names, altitudes_m, actions: "TargetActi
         i = int(leader[j])
         for label, value in fields:
             if not _same(value(i), value(int(j))):
-                first, second = ((rows[i], rows[j]) if rows is not None
-                                 else (f"target {i + 1}", f"target {j + 1}"))
+                first, second = target_name(rows, i), target_name(rows, int(j))
                 raise InputError(f"{where}: {first} and {second} are at the same position with a "
                                  f"different {label} ({value(i)!r} and {value(int(j))!r}); "
                                  "remove one of them or move it")
