@@ -75,3 +75,16 @@ def test_every_command_has_help_with_an_example():
     missing = [" ".join(path) for path in commands(cli, [])
                if "Example" not in CliRunner().invoke(cli, [*path, "--help"]).output]
     assert not missing, f"no example in --help of: {missing}"
+
+
+def test_no_command_module_imports_another():
+    """Commands share code through cli.options and cli.runs, never through each other."""
+    import ast
+    from pathlib import Path
+    folder = Path(__file__).resolve().parents[1] / "dtsp_mission" / "cli"
+    commands = {p.stem for p in folder.glob("*_command.py")}
+    for path in folder.glob("*_command.py"):
+        for node in ast.walk(ast.parse(path.read_text())):
+            if isinstance(node, ast.ImportFrom):
+                imported = (node.module or "").split(".")[-1]
+                assert imported not in commands, f"{path.name} imports {node.module}"

@@ -15,11 +15,12 @@ the vehicle's parameters (:meth:`Airframe.from_parameters`).
 from __future__ import annotations
 
 import math
-from dataclasses import dataclass, field, replace
+from dataclasses import dataclass, replace
 
 import numpy as np
 
 from . import flight_kernel as K
+from ..errors import InputError
 from .commands import Command, Frame
 from .parameters import ARDUPLANE_DEFAULTS, VehicleParameters
 
@@ -145,6 +146,33 @@ class AircraftState:
 
 #: Commands without a position, whatever frame a vehicle stores them in.
 _NO_POSITION = {Command.NAV_RETURN_TO_LAUNCH}
+
+
+def parameters_with(parameters: VehicleParameters, airspeed_m_s: float | None = None,
+                    max_bank_deg: float | None = None, l1_period_s: float | None = None,
+                    rho_m: float | None = None) -> VehicleParameters:
+    """``parameters`` with the cruise airspeed, the roll limit and NAVL1_PERIOD replaced where
+    given; ``rho_m`` without ``max_bank_deg`` sets the roll limit at which this model (turning
+    at :data:`SITL_TURN_EFFICIENCY` of the coordinated rate) turns no tighter than ``rho_m``.
+    :class:`InputError` for a value out of range."""
+    if airspeed_m_s is not None:
+        if not airspeed_m_s > 0:
+            raise InputError(f"the airspeed must be above 0 m/s, got {airspeed_m_s:g}")
+        parameters = replace(parameters, AIRSPEED_CRUISE=airspeed_m_s)
+    if l1_period_s is not None:
+        if not l1_period_s > 0:
+            raise InputError(f"the L1 period must be above 0 s, got {l1_period_s:g}")
+        parameters = replace(parameters, NAVL1_PERIOD=l1_period_s)
+    if max_bank_deg is not None or rho_m is not None:
+        if max_bank_deg is None:
+            if not rho_m > 0:
+                raise InputError(f"the turn radius must be above 0 m, got {rho_m:g}")
+            speed = parameters.AIRSPEED_CRUISE
+            max_bank_deg = math.degrees(math.atan(speed ** 2 / (G * rho_m * SITL_TURN_EFFICIENCY)))
+        if not 0 < max_bank_deg < 90:
+            raise InputError(f"the maximum bank must be between 0 and 90 deg, got {max_bank_deg:g}")
+        parameters = replace(parameters, ROLL_LIMIT_DEG=max_bank_deg)
+    return parameters
 
 
 def local_items(wire: list, frame, home_amsl_m: float) -> list[LocalItem]:

@@ -4,79 +4,14 @@ each target -- the check before a real flight."""
 from __future__ import annotations
 
 import click
-import numpy as np
 
-from ..autopilot.navigation import CALM, check_wind
-from ..sim.fly import (FlightCheck, check_targets_near, estimated_flight_m, fly_mission,
-                       targets_from, targets_in)
+from ..autopilot.navigation import check_wind
+from ..sim.fly import check_targets_near, targets_from, targets_in
 from . import console
-from .console import console_options, note, record, say
-from .options import (UserError, apply, progress_reporter, reports_errors, simulation_options,
+from .console import console_options, note, say
+from .options import (UserError, airframe_from, apply, reports_errors, simulation_options,
                       vehicle_options)
-from .sim_command import airframe_from
-
-
-def run_flight_check(mission, targets, airframe, via: str, speedup: float,
-                     max_miss_m: float | None, max_items: int | None = None,
-                     wind=None) -> FlightCheck:
-    """Fly, print the report, and fail (exit 1) when ``max_miss_m`` is exceeded (shared with
-    ``plan --simulate``)."""
-    _say_estimate(mission, airframe, speedup)
-    progress, close = progress_reporter("flying")
-    try:
-        check = fly_mission(mission, targets, airframe, via=via, speedup=speedup, max_items=max_items,
-                            wind=wind or CALM,
-                            progress=lambda stage, done, total: progress(done, total)
-                            if stage == "flight" else None)
-    finally:
-        close()
-    print_check(check)
-    if max_miss_m is not None and check.max_miss_m > max_miss_m:
-        raise click.ClickException(f"a target was missed by {check.max_miss_m:.1f} m, more than "
-                                   f"--max-miss {max_miss_m:g} m")
-    return check
-
-
-def _say_estimate(mission, airframe, speedup: float) -> None:
-    """Say up front how long the flight will take (flight time, and the wait at ``speedup``)."""
-    length = estimated_flight_m(mission, airframe.loiter_radius_m)
-    flight_s = length / airframe.airspeed_m_s
-    wait = (f"about {_duration(flight_s / speedup)} to simulate at --speedup {speedup:g}"
-            if speedup > 0 else "simulated as fast as it computes")
-    say(f"flying about {length / 1000:,.1f} km, {_duration(flight_s)} of flight; {wait}")
-
-
-def _duration(seconds: float) -> str:
-    if seconds < 90:
-        return f"{seconds:.0f} s"
-    minutes = int(round(seconds / 60))
-    return f"{minutes // 60} h {minutes % 60:02d} min" if minutes >= 60 else f"{minutes} min"
-
-
-def print_check(check: FlightCheck) -> None:
-    minutes = check.flight_time_s / 60
-    state = "completed" if check.completed else "NOT completed"
-    record(flight={"completed": check.completed, "items_reached": check.items_reached,
-                   "items": check.items, "flight_time_s": check.flight_time_s,
-                   "min_turn_radius_m": check.min_turn_radius_m, "position_reports": check.samples,
-                   "targets": [{"name": name, "miss_m": miss,
-                                "altitude_error_m": altitude if np.isfinite(altitude) else None}
-                               for name, miss, altitude in zip(check.names, check.miss_m,
-                                                               check.altitude_error_m)],
-                   "max_miss_m": check.max_miss_m})
-    say(f"simulated flight {state}: {check.items_reached} of {check.items} items, "
-               f"{minutes:.1f} min of flight (L1 period {check.airframe.l1_period_s:g} s, "
-               f"min turn radius {check.airframe.min_turn_radius_m:g} m)")
-    say(f"uploaded via {check.upload.via} in {check.upload.seconds:.2f} s; "
-               f"{check.samples} position reports received")
-    say(f"smallest turn radius in the telemetry: {check.min_turn_radius_m:.1f} m")
-    if len(check.miss_m):
-        say(f"targets passed within: median {np.median(check.miss_m):.2f} m, max "
-                   f"{check.max_miss_m:.2f} m")
-        say("target\tmiss_m\taltitude_error_m")
-        for name, miss, altitude in zip(check.names, check.miss_m, check.altitude_error_m):
-            say(f"{name}\t{miss:.2f}\t" + (f"{altitude:+.1f}" if np.isfinite(altitude)
-                                            else "-"))    # no altitude given for the target
+from .runs import run_flight_check
 
 
 @click.command()

@@ -266,3 +266,29 @@ def progress_reporter(label: str):
             bar.__exit__(None, None, None)
 
     return progress, close
+
+
+def airframe_from(vehicle_params_file, airspeed_m_s, max_bank_deg, l1_period_s,
+                  rho_m=None):
+    """The simulated aircraft: an ArduPlane with the parameters of ``vehicle_params_file``
+    (a stock one without), overridden by the options given: ``--airspeed`` (cruise),
+    ``--max-bank`` (roll limit), ``--radius`` (a roll limit that turns no tighter than it),
+    ``--l1-period``; and the one-line description of it the commands print."""
+    from ..autopilot.navigation import Airframe, parameters_with
+    from ..autopilot.parameters import ARDUPLANE_DEFAULTS
+    parameters = designed_for(vehicle_params_file) or ARDUPLANE_DEFAULTS
+    parameters = parameters_with(parameters, airspeed_m_s, max_bank_deg, l1_period_s, rho_m)
+    origin = (f"parameters from {vehicle_params_file}" if vehicle_params_file
+              else "stock parameters")
+    source = (f"ArduPlane navigation: {origin}, cruise {parameters.AIRSPEED_CRUISE:g} m/s, roll "
+              f"limit {parameters.ROLL_LIMIT_DEG:.0f} deg, NAVL1_PERIOD "
+              f"{parameters.NAVL1_PERIOD:g} s, WP_RADIUS {parameters.WP_RADIUS:g} m")
+    return Airframe.from_parameters(parameters), parameters, source
+
+
+def designed_for(vehicle_params_file):
+    """The parameters a mission is designed for: the file's, or None (a stock vehicle's)."""
+    if not vehicle_params_file:
+        return None
+    from ..autopilot.parameters import read_parameters
+    return read_parameters(vehicle_params_file)

@@ -29,9 +29,11 @@ from ..targets.geojson_file import read_geojson
 from . import console
 from .console import console_options, note, record, say
 from ..autopilot.navigation import CALM
-from .options import (FiniteFloatRange, LAT_LON, UserError, apply, link_options, mission_options,
-                      mission_settings, progress_reporter, reports_errors, seed_option, simulation_options,
-                      turn_radius_from, vehicle_options)
+from .options import (FiniteFloatRange, LAT_LON, UserError, airframe_from, apply,
+                      designed_for as designed_for_file, link_options, mission_options,
+                      mission_settings, progress_reporter, reports_errors, seed_option,
+                      simulation_options, turn_radius_from, vehicle_options)
+from .runs import run_flight_check, run_upload
 
 
 def _check_writable(paths) -> None:
@@ -177,7 +179,7 @@ def plan(targets_file, random_count, area_file, seed, origin, rho_m, airspeed_m_
         MissionSettings(max_items=max_items).checked(1.0)
     if algorithm in ("rbta", "auto") and region not in ("bounding", "min-area"):
         region_heading_deg(region)
-    designed_for = _designed_for(vehicle_params_file)
+    designed_for = designed_for_file(vehicle_params_file)
     rho, rho_source = turn_radius_from(rho_m, airspeed_m_s, max_bank_deg,
                                        designed_for.ROLL_LIMIT_DEG if designed_for else None)
     check_radius(rho)
@@ -267,7 +269,6 @@ def plan(targets_file, random_count, area_file, seed, origin, rho_m, airspeed_m_
                                                          result.area_m)))
     upload = None
     if connection:
-        from .upload_command import run_upload
 
         def upload() -> None:
             run_upload(product.for_vehicle(), connection, via, verify, signing_key_file,
@@ -281,8 +282,6 @@ def plan(targets_file, random_count, area_file, seed, origin, rho_m, airspeed_m_
             console.current().summary.setdefault("files", []).append(str(output))
     if simulate:
         from ..sim.fly import planned_targets
-        from .fly_command import run_flight_check
-        from .sim_command import airframe_from
         airframe, _, _ = airframe_from(vehicle_params_file, airspeed_m_s, None, l1_period_s)
         for k, flown in enumerate([s.mission for s in sorties] or [product]):
             if sorties:
@@ -369,14 +368,6 @@ def _warn_far_home(mission, targets_m: np.ndarray, frame) -> None:
     if nearest > FAR_HOME_M:
         note(f"home is {nearest / 1000:.1f} km from the nearest target: is --home right? "
              "(the transit there and back is part of every flight)")
-
-
-def _designed_for(vehicle_params_file):
-    """The parameters a mission is designed for: the file's, or None (a stock vehicle's)."""
-    if not vehicle_params_file:
-        return None
-    from ..autopilot.parameters import read_parameters
-    return read_parameters(vehicle_params_file)
 
 
 def _report_tour(result: PlanResult) -> None:

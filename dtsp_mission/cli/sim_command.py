@@ -2,54 +2,17 @@
 
 from __future__ import annotations
 
-import math
 import time
 
 import click
 
+from ..autopilot.navigation import CALM, check_wind
 from ..mission import AUTOPILOTS
 from ..mission.model import Home
-from dataclasses import replace
-
-from ..autopilot.navigation import G, SITL_TURN_EFFICIENCY, Airframe
-from ..autopilot.parameters import ARDUPLANE_DEFAULTS, VehicleParameters, read_parameters
 from ..sim.vehicle import SimulatedVehicle, VehicleSettings
 from ..upload.connection import read_signing_key
-from ..autopilot.navigation import CALM, check_wind
-from .options import (LAT_LON, UserError, apply, reports_errors, simulation_options,
-                      vehicle_options)
-
-
-def airframe_from(vehicle_params_file, airspeed_m_s, max_bank_deg, l1_period_s,
-                  rho_m=None) -> tuple[Airframe, VehicleParameters, str]:
-    """The simulated aircraft: an ArduPlane with the parameters of ``vehicle_params_file``
-    (a stock one without), overridden by the options given: ``--airspeed`` (cruise),
-    ``--max-bank`` (roll limit), ``--radius`` (a roll limit that turns no tighter than it),
-    ``--l1-period``."""
-    parameters = read_parameters(vehicle_params_file) if vehicle_params_file else ARDUPLANE_DEFAULTS
-    if airspeed_m_s is not None:
-        if not airspeed_m_s > 0:
-            raise UserError(f"--airspeed must be above 0 m/s, got {airspeed_m_s:g}")
-        parameters = replace(parameters, AIRSPEED_CRUISE=airspeed_m_s)
-    if l1_period_s is not None:
-        if not l1_period_s > 0:
-            raise UserError(f"--l1-period must be above 0 s, got {l1_period_s:g}")
-        parameters = replace(parameters, NAVL1_PERIOD=l1_period_s)
-    if max_bank_deg is not None or rho_m is not None:
-        if max_bank_deg is None:
-            if not rho_m > 0:
-                raise UserError(f"the turn radius must be above 0 m, got {rho_m:g}")
-            # the bank at which this airframe (turning at SITL_TURN_EFFICIENCY of the
-            # coordinated rate) turns at rho_m
-            speed = parameters.AIRSPEED_CRUISE
-            max_bank_deg = math.degrees(math.atan(speed ** 2 / (G * rho_m * SITL_TURN_EFFICIENCY)))
-        if not 0 < max_bank_deg < 90:
-            raise UserError(f"--max-bank must be between 0 and 90 deg, got {max_bank_deg:g}")
-        parameters = replace(parameters, ROLL_LIMIT_DEG=max_bank_deg)
-    source = (f"ArduPlane navigation: {'parameters from ' + str(vehicle_params_file) if vehicle_params_file else 'stock parameters'}, "
-              f"cruise {parameters.AIRSPEED_CRUISE:g} m/s, roll limit {parameters.ROLL_LIMIT_DEG:.0f} deg, "
-              f"NAVL1_PERIOD {parameters.NAVL1_PERIOD:g} s, WP_RADIUS {parameters.WP_RADIUS:g} m")
-    return Airframe.from_parameters(parameters), parameters, source
+from .options import (LAT_LON, UserError, airframe_from, apply, reports_errors,
+                      simulation_options, vehicle_options)
 
 
 @click.command()

@@ -4,50 +4,11 @@ from __future__ import annotations
 
 import click
 
-from ..upload import to_wire, upload_mission
-from ..upload.connection import read_signing_key
 from . import console
-from .console import console_options, note, record, say
-from .options import (UserError, apply, link_options, mission_options, mission_settings,
-                      progress_reporter, reports_errors, vehicle_options)
-
-
-def run_upload(mission, connection: str, via: str, verify: bool, signing_key_file: str | None,
-               heartbeat_timeout_s: float | None = None, designed_for=None,
-               transfer_timeout_s: float | None = None) -> None:
-    """Upload with a progress bar and print what happened (shared with ``plan --upload``)."""
-    key = read_signing_key(signing_key_file) if signing_key_file else None
-    progress, close = progress_reporter("uploading")
-    slots = len(to_wire(mission))
-    if not mission.autopilot_stated:      # the vehicle's autopilot decides the home slot
-        what = f"{len(mission.items)} mission items (and a home slot if the vehicle is ArduPilot)"
-    elif slots > len(mission.items):
-        what = f"{len(mission.items)} mission items and the home slot ({slots} mission slots)"
-    else:
-        what = f"{len(mission.items)} mission items ({slots} mission slots)"
-    say(f"uploading {what} to {connection} via {via}")
-    try:
-        report = upload_mission(mission, connection, via=via, verify=verify, signing_key=key,
-                                progress=progress, heartbeat_timeout_s=heartbeat_timeout_s,
-                                designed_for=designed_for, timeout_s=transfer_timeout_s)
-    finally:
-        close()
-    for warning in report.warnings:
-        note(f"warning: {warning}")
-    fresh = f", {report.fresh_starts} fresh starts" if report.fresh_starts else ""
-    line = (f"the vehicle accepted {report.items} mission slots in {report.seconds:.2f} s "
-            f"({report.resent} messages resent{fresh})")
-    held = ("exactly the planned mission" if not mission.not_carried else
-            "exactly the planned mission items (not what was not sent: "
-            + ", ".join(mission.not_carried) + ")")
-    say(line + (f"; downloaded back: it holds {held}" if report.verified
-                else "; not verified (--no-verify)"))
-    if report.note:
-        note(report.note)
-    record(upload={"via": report.via, "mission_slots": report.items, "seconds": report.seconds,
-                   "transfer_s": report.transfer_s, "resent": report.resent,
-                   "fresh_starts": report.fresh_starts, "verified": report.verified,
-                   "round_trip_s": report.round_trip_s})
+from .console import console_options, say
+from .options import (UserError, apply, designed_for, link_options, mission_options,
+                      mission_settings, reports_errors, vehicle_options)
+from .runs import run_upload
 
 
 @click.command()
@@ -95,9 +56,8 @@ def upload(mission_file, connection, via, verify, signing_key_file, transfer_tim
         mission = _tour_mission(mission_file, mission_settings(**mission_option_values))
     else:
         mission = read_mission(mission_file, format_name)
-    from .plan_command import _designed_for
     run_upload(mission, connection, via, verify, signing_key_file, heartbeat_timeout_s,
-               _designed_for(vehicle_params_file), transfer_timeout_s)
+               designed_for(vehicle_params_file), transfer_timeout_s)
     console.finish()
 
 
