@@ -30,7 +30,7 @@ from dtsp_mission.autopilot.navigation import (MODEL_STEP_S, Airframe, MissionFl
 from dtsp_mission.export import read_mission  # noqa: E402
 from dtsp_mission.frame import LocalFrame  # noqa: E402
 from dtsp_mission.sim.predict import predict_flight  # noqa: E402
-from dtsp_mission.upload.wire import first_mission_seq, to_wire  # noqa: E402
+from dtsp_mission.autopilot.wire import first_mission_seq, to_wire  # noqa: E402
 
 
 def bundled_mission(folder: Path) -> Path:

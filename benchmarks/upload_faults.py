@@ -25,7 +25,7 @@ from dtsp_mission.mission.model import waypoint
 from dtsp_mission.sim.fault_proxy import FaultProxy, Faults
 from dtsp_mission.sim.vehicle import SimulatedVehicle, VehicleSettings
 from dtsp_mission.upload import upload_mission
-from dtsp_mission.upload.wire import describe_vehicle, differences, to_wire
+from dtsp_mission.autopilot.wire import describe_vehicle, differences, to_wire
 
 HOME = Home(46.8, 6.95, 450.0)
 #: Mission slots of the vehicle: an ArduPilot board with SD storage (a stock one holds 655).

@@ -18,7 +18,7 @@ from dtsp_mission.mission.model import waypoint
 from dtsp_mission.sim.fault_proxy import FaultProxy, Faults
 from dtsp_mission.sim.vehicle import SimulatedVehicle, VehicleSettings
 from dtsp_mission.upload import upload_mission
-from dtsp_mission.upload.wire import differences, to_wire
+from dtsp_mission.autopilot.wire import differences, to_wire
 
 HOME = Home(46.8, 6.95, 450.0)
 

@@ -20,7 +20,7 @@ from dtsp_mission.autopilot.navigation import Airframe
 from dtsp_mission.sim.vehicle import SimulatedVehicle, VehicleSettings
 from dtsp_mission.targets import GeoTargets
 from dtsp_mission.upload import download_mission, to_wire, upload_mission
-from dtsp_mission.upload.wire import differences
+from dtsp_mission.autopilot.wire import differences
 
 # Twelve survey markers (WGS84 degrees) on a 2 km field, each with a name.
 LATITUDES = [46.8012, 46.8031, 46.8055, 46.8074, 46.8090, 46.8102,

@@ -25,7 +25,7 @@ from dtsp_mission.autopilot.parameters import read_parameters
 from dtsp_mission.errors import DtspError
 from dtsp_mission.export import exporter_for, read_mission
 from dtsp_mission.targets import read_targets
-from dtsp_mission.upload.wire import to_wire
+from dtsp_mission.autopilot.wire import to_wire
 
 ROOT = Path(__file__).resolve().parents[1]
 TEXT_VALUES = ["", "nan", "NaN", "inf", "-inf", "1e309", "-1", "0", "999", "-999", "1e-320",

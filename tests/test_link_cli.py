@@ -18,7 +18,7 @@ from dtsp_mission.autopilot import Autopilot
 from dtsp_mission.autopilot.navigation import Airframe
 from dtsp_mission.cli.main import cli
 from dtsp_mission.export import exporter_for
-from dtsp_mission.upload.wire import differences, to_wire
+from dtsp_mission.autopilot.wire import differences, to_wire
 
 SITE = os.path.join(os.path.dirname(__file__), "..", "examples", "site-inspection.csv")
 

@@ -22,6 +22,9 @@ import math
 from dataclasses import dataclass, replace
 
 import numpy as np
+from pymavlink.dialects.v20.common import (MAV_MISSION_ACCEPTED, MAV_MISSION_ERROR,
+                                           MAV_MISSION_NO_SPACE, MAV_MISSION_UNSUPPORTED,
+                                           MAV_MISSION_UNSUPPORTED_FRAME)
 
 from .commands import Autopilot, Command, Frame
 
@@ -226,9 +229,9 @@ def capacity(autopilot: Autopilot) -> int:
 
 # -- how a vehicle writes an upload --------------------------------------------------------------
 
-#: MAV_MISSION_RESULT values the store answers with.
-ACCEPTED, ERROR, NO_SPACE = 0, 1, 4
-UNSUPPORTED_FRAME, UNSUPPORTED = 2, 3
+#: MAV_MISSION_RESULT values the store answers with (pymavlink's).
+ACCEPTED, ERROR, NO_SPACE = MAV_MISSION_ACCEPTED, MAV_MISSION_ERROR, MAV_MISSION_NO_SPACE
+UNSUPPORTED_FRAME, UNSUPPORTED = MAV_MISSION_UNSUPPORTED_FRAME, MAV_MISSION_UNSUPPORTED
 
 #: The MAV_CMD values a mission takes (ArduPilot's AP_Mission converts these; what else it is
 #: sent it answers MAV_MISSION_UNSUPPORTED): navigation, conditions, DO_ and camera commands.

@@ -21,14 +21,13 @@ from __future__ import annotations
 import time
 from typing import Callable
 
+from pymavlink.dialects.v20.common import (MAV_MISSION_DENIED, MAV_MISSION_INVALID_SEQUENCE,
+                                           MAV_MISSION_OPERATION_CANCELLED, MAV_MISSION_UNSUPPORTED,
+                                           MAV_SEVERITY_INFO, MAV_SEVERITY_WARNING)
+
 from ..autopilot import Autopilot
 from ..autopilot.storage import ACCEPTED, ERROR, MISSION_TYPE_MISSION, MissionStore, wire_item_from
 
-MAV_MISSION_UNSUPPORTED = 3
-MAV_MISSION_INVALID_SEQUENCE = 13
-MAV_MISSION_DENIED = 14
-MAV_MISSION_OPERATION_CANCELLED = 15
-MAV_SEVERITY_WARNING, MAV_SEVERITY_INFO = 4, 6
 
 #: ``send(build)``: run ``build(encoder)`` with the vehicle's pymavlink encoder, its source ids set.
 Send = Callable[[Callable], None]

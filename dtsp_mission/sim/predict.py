@@ -17,7 +17,7 @@ from ..autopilot.navigation import (CALM, FLIGHT_LIMIT_S, MODEL_STEP_S, Airframe
                                     local_items)
 from ..frame import LocalFrame
 from ..mission import VehicleMission
-from ..upload.wire import first_mission_seq, to_wire
+from ..autopilot.wire import first_mission_seq, to_wire
 
 _FLOWN = (Command.NAV_WAYPOINT, Command.NAV_LOITER_TURNS, Command.NAV_LOITER_TIME)
 

@@ -27,6 +27,13 @@ from dataclasses import dataclass, field
 import numpy as np
 from pymavlink.dialects.v20 import ardupilotmega
 from pymavlink.dialects.v20 import common as mavlink2
+from pymavlink.dialects.v20.common import (MAVLINK_MSG_ID_HOME_POSITION, MAV_CMD_MISSION_START,
+                                           MAV_CMD_REQUEST_MESSAGE, MAV_MODE_FLAG_AUTO_ENABLED,
+                                           MAV_MODE_FLAG_CUSTOM_MODE_ENABLED,
+                                           MAV_MODE_FLAG_SAFETY_ARMED, MAV_PARAM_TYPE_REAL32,
+                                           MAV_RESULT_ACCEPTED, MAV_RESULT_DENIED,
+                                           MAV_STATE_ACTIVE, MAV_STATE_STANDBY,
+                                           MAV_TYPE_FIXED_WING)
 
 from ..autopilot.navigation import (CALM, MODEL_STEP_S, Airframe, LocalItem, MissionFlight, Wind,
                                     local_items)
@@ -36,23 +43,11 @@ from ..frame import LocalFrame
 from ..mavsdk_log import quiet_mavsdk_log
 from ..mission import Autopilot
 from ..mission.model import Home, degrees_to_e7
-from ..upload.wire import WireItem, first_mission_seq, home_placeholder
+from ..autopilot.wire import WireItem, first_mission_seq, home_placeholder
 from .mission_server import MissionServer
 from .transport import Transport, UdpTransport, open_transport
 from ..vehicle import heading_to_bearing_deg
 
-MAV_TYPE_FIXED_WING = 1
-MAV_CMD_MISSION_START = 300
-MAV_CMD_REQUEST_MESSAGE = 512
-MAVLINK_MSG_ID_HOME_POSITION = 242
-MAV_PARAM_TYPE_REAL32 = 9
-MAV_RESULT_ACCEPTED = 0
-MAV_RESULT_DENIED = 2
-MAV_STATE_STANDBY, MAV_STATE_ACTIVE = 3, 4
-MAV_MODE_FLAG_CUSTOM_MODE_ENABLED = 1
-MAV_MODE_FLAG_AUTO_ENABLED = 4
-MAV_MODE_FLAG_SAFETY_ARMED = 128
-MAV_SEVERITY_WARNING = 4
 SIGNING_EPOCH_S = 1420070400     # MAVLink 2 signing timestamps count from 2015-01-01
 
 

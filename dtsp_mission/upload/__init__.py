@@ -18,7 +18,7 @@ from ..errors import InputError, LinkError
 from ..mission import Command, VehicleMission
 from ..plugins import load_group, working
 from .base import VEHICLE_GIVES_UP_S, Progress, Uploader, VehicleInfo
-from .wire import WireItem, describe_vehicle, differences, to_wire
+from ..autopilot.wire import WireItem, describe_vehicle, differences, to_wire
 
 UPLOADER_GROUP = "dtsp_mission.uploaders"
 

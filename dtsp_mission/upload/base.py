@@ -10,7 +10,7 @@ from __future__ import annotations
 from dataclasses import dataclass, field
 from typing import Callable
 
-from .wire import WireItem
+from ..autopilot.wire import WireItem
 
 #: ``progress(done, total, resent)`` as a transfer advances: items through, items in all, and
 #: messages sent again so far (0 from an uploader that cannot tell).

@@ -8,7 +8,7 @@ from ..errors import LinkError
 from ..mavsdk_log import quiet_mavsdk_log
 from .base import Progress, Uploader
 from .connection import mavsdk_url
-from .wire import WireItem
+from ..autopilot.wire import WireItem
 
 #: What each failing MissionRawResult means to the user.
 _RESULTS = {

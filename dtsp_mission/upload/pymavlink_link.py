@@ -13,6 +13,11 @@ import os
 import time
 
 from pymavlink import mavutil
+from pymavlink.dialects.v20.common import (MAV_AUTOPILOT_ARDUPILOTMEGA, MAV_AUTOPILOT_INVALID,
+                                           MAV_CMD_REQUEST_MESSAGE, MAV_MISSION_DENIED,
+                                           MAV_MISSION_ERROR, MAV_MISSION_INVALID_SEQUENCE,
+                                           MAV_MISSION_OPERATION_CANCELLED, MAV_TYPE_GCS,
+                                           MAVLINK_MSG_ID_HOME_POSITION)
 
 from ..autopilot.parameters import parameter_name
 from ..errors import LinkError
@@ -22,17 +27,10 @@ from .base import (MIN_TIMEOUT_S, TIMEOUT_S, VEHICLE_GIVES_UP_S, Progress, Uploa
                    transfer_timeout_s)
 from .results import ITEM_RESULTS, NO_SPACE, result_text
 from ..autopilot.storage import wire_item_from
-from .wire import MISSION_TYPE_MISSION, WireItem
+from ..autopilot.wire import MISSION_TYPE_MISSION, WireItem
 
 GCS_SYSTEM_ID = 255
 GCS_COMPONENT_ID = 190          # MAV_COMP_ID_MISSIONPLANNER
-MAV_TYPE_GCS = 6
-MAV_AUTOPILOT_INVALID = 8
-MAV_AUTOPILOT_ARDUPILOTMEGA = 3
-MAV_MISSION_ERROR = 1
-MAV_MISSION_INVALID_SEQUENCE = 13
-MAV_MISSION_DENIED = 14
-MAV_MISSION_OPERATION_CANCELLED = 15
 #: A vehicle that never asks for an item in this long is not taking missions from us (it
 #: ignores our messages: unsigned to a signing vehicle, another system id ...).
 FIRST_ANSWER_S = 6.0
@@ -47,8 +45,6 @@ MAX_FRESH_STARTS = 20
 #: Request timeouts in a row without any item before a download starts a new transfer.
 DOWNLOAD_RESTART_AFTER = 4
 HEARTBEAT_PERIOD_S = 1.0
-MAV_CMD_REQUEST_MESSAGE = 512
-MAVLINK_MSG_ID_HOME_POSITION = 242
 
 
 def use_mavlink2() -> None:

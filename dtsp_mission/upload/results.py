@@ -1,28 +1,38 @@
-"""MAV_MISSION_RESULT values and what each means to the person uploading."""
+"""MAV_MISSION_RESULT values (pymavlink's) and what each means to the person uploading."""
 
 from __future__ import annotations
 
-MISSION_RESULTS: dict[int, tuple[str, str]] = {
-    0: ("MAV_MISSION_ACCEPTED", "accepted"),
-    1: ("MAV_MISSION_ERROR", "the vehicle reported a generic error"),
-    2: ("MAV_MISSION_UNSUPPORTED_FRAME", "the vehicle does not support the coordinate frame"),
-    3: ("MAV_MISSION_UNSUPPORTED", "the vehicle does not support the command"),
-    4: ("MAV_MISSION_NO_SPACE", "the vehicle has no room for this many items"),
-    5: ("MAV_MISSION_INVALID", "an item has an invalid parameter"),
-    6: ("MAV_MISSION_INVALID_PARAM1", "param1 is invalid"),
-    7: ("MAV_MISSION_INVALID_PARAM2", "param2 is invalid"),
-    8: ("MAV_MISSION_INVALID_PARAM3", "param3 is invalid"),
-    9: ("MAV_MISSION_INVALID_PARAM4", "param4 is invalid"),
-    10: ("MAV_MISSION_INVALID_PARAM5_X", "param5 (latitude) is invalid"),
-    11: ("MAV_MISSION_INVALID_PARAM6_Y", "param6 (longitude) is invalid"),
-    12: ("MAV_MISSION_INVALID_PARAM7", "param7 (altitude) is invalid"),
-    13: ("MAV_MISSION_INVALID_SEQUENCE", "an item arrived out of sequence"),
-    14: ("MAV_MISSION_DENIED", "the vehicle does not accept missions now (armed or busy?)"),
-    15: ("MAV_MISSION_OPERATION_CANCELLED", "the operation was cancelled"),
+from pymavlink.dialects.v20.common import MAV_MISSION_NO_SPACE, enums
+
+#: What each result means, in the uploader's words (pymavlink gives the names and values).
+_MEANINGS = {
+    "MAV_MISSION_ACCEPTED": "accepted",
+    "MAV_MISSION_ERROR": "the vehicle reported a generic error",
+    "MAV_MISSION_UNSUPPORTED_FRAME": "the vehicle does not support the coordinate frame",
+    "MAV_MISSION_UNSUPPORTED": "the vehicle does not support the command",
+    "MAV_MISSION_NO_SPACE": "the vehicle has no room for this many items",
+    "MAV_MISSION_INVALID": "an item has an invalid parameter",
+    "MAV_MISSION_INVALID_PARAM1": "param1 is invalid",
+    "MAV_MISSION_INVALID_PARAM2": "param2 is invalid",
+    "MAV_MISSION_INVALID_PARAM3": "param3 is invalid",
+    "MAV_MISSION_INVALID_PARAM4": "param4 is invalid",
+    "MAV_MISSION_INVALID_PARAM5_X": "param5 (latitude) is invalid",
+    "MAV_MISSION_INVALID_PARAM6_Y": "param6 (longitude) is invalid",
+    "MAV_MISSION_INVALID_PARAM7": "param7 (altitude) is invalid",
+    "MAV_MISSION_INVALID_SEQUENCE": "an item arrived out of sequence",
+    "MAV_MISSION_DENIED": "the vehicle does not accept missions now (armed or busy?)",
+    "MAV_MISSION_OPERATION_CANCELLED": "the operation was cancelled",
 }
 
-ITEM_RESULTS = {2, 3, 5, 6, 7, 8, 9, 10, 11, 12}
-NO_SPACE = 4
+MISSION_RESULTS: dict[int, tuple[str, str]] = {
+    value: (entry.name, _MEANINGS[entry.name])
+    for value, entry in enums["MAV_MISSION_RESULT"].items() if entry.name in _MEANINGS}
+
+#: The results that refuse one item (its frame, command or a parameter), not the upload.
+ITEM_RESULTS = {value for value, (name, _) in MISSION_RESULTS.items()
+                if name.startswith(("MAV_MISSION_UNSUPPORTED", "MAV_MISSION_INVALID"))
+                and name != "MAV_MISSION_INVALID_SEQUENCE"}
+NO_SPACE = MAV_MISSION_NO_SPACE
 
 
 def result_text(result: int) -> str:

@@ -17,7 +17,7 @@ import pytest
 from dtsp_mission.autopilot import Autopilot, WireItem, stored_item
 from dtsp_mission.autopilot.storage import ACCEPTED, UNSUPPORTED, MissionStore
 from dtsp_mission.export import read_mission
-from dtsp_mission.upload.wire import describe_vehicle, differences, to_wire
+from dtsp_mission.autopilot.wire import describe_vehicle, differences, to_wire
 
 DATA = Path(__file__).resolve().parents[1] / "data" / "px4-sitl"
 CASES = sorted(p.name for p in DATA.iterdir() if (p / "readback.json").exists())

@@ -11,7 +11,7 @@ import pytest
 from conftest import make_mission
 from dtsp_mission.autopilot.navigation import G, Airframe, MissionFlight, closest_approach_m
 from dtsp_mission.sim.vehicle import SimulatedVehicle, VehicleSettings
-from dtsp_mission.upload.wire import first_mission_seq, to_wire
+from dtsp_mission.autopilot.wire import first_mission_seq, to_wire
 
 
 def fly_offline(mission, airframe: Airframe):

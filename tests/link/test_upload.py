@@ -15,7 +15,7 @@ from conftest import free_udp_port, make_mission
 from dtsp_mission.errors import InputError, LinkError
 from dtsp_mission.sim.fault_proxy import Faults, FaultProxy
 from dtsp_mission.upload import download_mission, upload_mission
-from dtsp_mission.upload.wire import differences, first_mission_seq, to_wire
+from dtsp_mission.autopilot.wire import differences, first_mission_seq, to_wire
 
 UPLOADERS = ["pymavlink", "mavsdk"]
 

@@ -6,7 +6,7 @@ import pytest
 
 from dtsp_mission.export import exporter_for
 from dtsp_mission.mission import Autopilot, Command, Frame
-from dtsp_mission.upload.wire import WireItem, describe_vehicle, differences, from_wire, to_wire
+from dtsp_mission.autopilot.wire import WireItem, describe_vehicle, differences, from_wire, to_wire
 from conftest import make_mission
 
 

@@ -20,7 +20,7 @@ from dtsp_mission.targets import read_targets
 from dtsp_mission.targets.actions import TargetActions
 from dtsp_mission.targets.model import local_targets
 from dtsp_mission.tour.check import check_path
-from dtsp_mission.upload.wire import to_wire
+from dtsp_mission.autopilot.wire import to_wire
 
 RHO_M = 60.0
 

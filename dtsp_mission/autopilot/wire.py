@@ -12,7 +12,7 @@ from __future__ import annotations
 
 from dataclasses import fields
 
-from ..autopilot.storage import MISSION_TYPE_MISSION, WireItem, comparable
+from .storage import MISSION_TYPE_MISSION, WireItem, comparable
 from ..mission import Autopilot, Command, Frame, VehicleMission, degrees_to_e7
 from ..mission.model import Home, MissionItem
 
