@@ -22,7 +22,7 @@ from .dubins.path import check_radius
 from .errors import InputError, MissionTooLarge
 from .frame import LocalFrame, mission_centre
 from .mission import Mission, MissionSettings, build_mission
-from .mission.build import (GUIDANCE_MARGINS, check_altitude_floor, check_storage, length_excess, targets_beyond,
+from .mission.build import (check_altitude_floor, check_storage, targets_beyond,
                             with_turn_margin)
 from .mission.sorties import Sortie, split_into_sorties
 from .planning import TilingUnavailable, get_planner
@@ -207,7 +207,7 @@ def _design_mission(request: PlanRequest, result: PlanResult,
     """The mission stage: build, widen the turns for the guidance, split where needed."""
     settings, frame, geodetic, tour = request.settings, result.frame, result.geodetic, result.tour
     endurance_s = request.endurance_s
-    designs = 1 + len(GUIDANCE_MARGINS)            # at most: the radius asked for, then wider
+    designs = 1 + len(settings.tuning.guidance_margins)   # at most: the radius asked, then wider
 
     def design_step(k: int) -> Callable[[int, int], None]:
         """Progress of the k-th design, as its share of all the designs' flights."""

@@ -28,7 +28,7 @@ from ..autopilot.navigation import CALM, MAX_WIND_M_S, Airframe, Wind, check_win
 from ..autopilot.parameters import ARDUPLANE_DEFAULTS, VehicleParameters
 from ..autopilot.storage import MAVLINK_MAX_ITEMS, capacity
 from . import actions as action_items
-from .guidance import GuidanceDesign, design_waypoints
+from .guidance import DesignTuning, GuidanceDesign, design_waypoints
 from .discretise import waypoint_s
 from .flight_path import TAKEOFF_CLIMB_DEG, climb_distance_m, plan_flight_path
 from .model import FlightPath, Home, Mission, MissionItem, waypoint
@@ -96,6 +96,7 @@ class MissionSettings:
                                               # default DEFAULT_WIND_SPREAD of it, at least 1 m/s
     model_margin_m: float | None = None       # guidance: held this much inside max_miss_m in the
                                               # model; default MODEL_MARGIN_M
+    tuning: DesignTuning = DesignTuning()     # guidance: the design's tuning (measured defaults)
     min_altitude_m: float = DEFAULT_MIN_ALTITUDE_M  # no target or cruise altitude below this
                                               # (above home); lower it only for a clear site
 
@@ -261,7 +262,8 @@ def _design_for_guidance(path: FlightPath, tour: Tour, frame: LocalFrame, target
                               budget, head, settings.target_acceptance_m, progress=progress,
                               as_stored=lambda points: stored_position_m(frame, points),
                               winds=settings.design_winds(),
-                              spread_margin_m=settings.max_miss_m - settings.design_limit_m)
+                              spread_margin_m=settings.max_miss_m - settings.design_limit_m,
+                              tuning=settings.tuning)
     return replace(design, s_m=np.concatenate([[0.0], design.s_m, tail]),
                    aim_m=np.vstack([path.chain.pose_at(np.array([0.0]))[:, :2], design.aim_m,
                                     path.chain.pose_at(tail)[:, :2].reshape(-1, 2)]),
@@ -622,9 +624,6 @@ def _items(path: FlightPath, chosen: np.ndarray, frame: LocalFrame, targets: Geo
     return items
 
 
-#: Turn radii tried for the guidance design when targets stay beyond --max-miss, in rho: a
-#: wider planned turn is one ArduPlane's L1 guidance can hold (docs/mission-items.md).
-GUIDANCE_MARGINS = (1.3, 1.6)
 def targets_beyond(mission: Mission, limit_m: float | None = None) -> int:
     """How many targets a guidance-designed mission does not hold: by default those judged
     beyond its design limit (--max-miss less the model's margin in the forecast wind, or
@@ -648,7 +647,7 @@ def with_turn_margin(mission: Mission, replan: Callable[[float], Tour], targets:
                      progress: Callable[[int], Callable[[int, int], None]] | None = None) -> Mission:
     """``mission`` (guidance design) if it holds every target, else the best of it and the
     missions of tours planned with wider turn radii (``replan(rho)``,
-    :data:`GUIDANCE_MARGINS`, tried in turn until one holds every target): the fewest targets
+    ``settings.tuning.guidance_margins``, tried in turn until one holds every target): the fewest targets
     beyond the design limit, then the shortest predicted flight -- flight time is what the
     operator pays for; how closely a flight follows its plan is only reported.
     ``progress(k)`` gives the progress callback of the k-th design tried (``mission``'s was the
@@ -656,7 +655,7 @@ def with_turn_margin(mission: Mission, replan: Callable[[float], Tour], targets:
     def key(candidate: Mission) -> tuple[int, float]:
         return targets_beyond(candidate), candidate.summary["predicted_flight_m"]
     best = mission
-    for index, factor in enumerate(GUIDANCE_MARGINS):
+    for index, factor in enumerate(settings.tuning.guidance_margins):
         if key(best)[0] == 0:
             break
         try:

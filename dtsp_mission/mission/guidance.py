@@ -10,34 +10,34 @@ checked against recorded ArduPlane flights) and repairing what it misses:
    a circle: a sharp change of direction between close targets) gets a waypoint every quarter
    turn on it, because from its ends alone the autopilot cuts inside it the wrong way round;
 2. fly the mission in the model; a target the predicted track misses by more than
-   ``CORRECT_ABOVE`` of ``max_miss_m`` has its waypoint moved by the miss (the aim point:
+   ``correct_above`` of ``max_miss_m`` has its waypoint moved by the miss (the aim point:
    where the autopilot must be sent so that it passes over the target);
 3. the round is kept only if the total miss beyond ``max_miss_m`` (each target beyond counted
-   ``BEYOND_COST`` of it more) shrinks; if not, the corrections that did not hurt where they
-   act (their target and the next ``AFFECTS_NEXT``) are flown alone; if that does not help
+   ``beyond_cost`` of it more) shrinks; if not, the corrections that did not hurt where they
+   act (their target and the next ``affects_next``) are flown alone; if that does not help
    either, the next round tries half the corrections (waypoints closer than the L1 distance
    pull each other's tracks, so full corrections of neighbours overshoot together);
-4. after ``IDLE_ROUNDS`` rounds in a row that gain less than ``PROGRESS``, each target still
+4. after ``idle_rounds`` rounds in a row that gain less than ``progress``, each target still
    beyond gets a shaping waypoint on the exact path before it (in the longest waypoint gap
-   within ``LOOKBACK_L1``) and the corrections go on from there;
-5. repeat until every target holds or the predicted flights (``ROUNDS``) or the item budget
+   within ``lookback_l1``) and the corrections go on from there;
+5. repeat until every target holds or the predicted flights (``rounds``) or the item budget
    are spent;
-6. the verifying flight: the design flown afresh at the model's own step (``VERIFY_STEP_S``,
+6. the verifying flight: the design flown afresh at the model's own step (``verify_step_s``,
    the step its agreement with ArduPlane was measured at, and the one ``fly`` and
    ``predict_flight`` use), every waypoint where the vehicle stores it (rounded to 1e-7
    degree: a switch one step earlier or later moves the track by decimetres);
 7. the local repair, at that step: each target it finds beyond, in visit order, is flown
-   again from a checkpoint of the flight ``LOCAL_BACK`` waypoints before it to
-   ``LOCAL_AHEAD`` after it (a few seconds of flight instead of the whole mission; none of the
+   again from a checkpoint of the flight ``local_back`` waypoints before it to
+   ``local_ahead`` after it (a few seconds of flight instead of the whole mission; none of the
    waypoints moved is at or before the checkpoint's), its own waypoint and the
-   ``LOCAL_MOVE`` before it moved by a pattern search (steps along east and north, halved when
+   ``local_move`` before it moved by a pattern search (steps along east and north, halved when
    none helps); if that leaves it beyond, the search again from those of them that stand for
-   targets put back on their targets (``LOCAL_RESET``), and from the best of ``LOCAL_STARTS``
-   random placements of them within ``LOCAL_SPREAD_M`` (none by default); the change is kept only if the mission flown
-   on from the checkpoint costs less.  Up to ``REFINE_PASSES`` passes, each ending with the whole mission flown afresh;
+   targets put back on their targets (``local_reset``), and from the best of ``local_starts``
+   random placements of them within ``local_spread_m`` (none by default); the change is kept only if the mission flown
+   on from the checkpoint costs less.  Up to ``refine_passes`` passes, each ending with the whole mission flown afresh;
    the design returned is the best of those fresh flights.
 
-The rounds 2-5 (at the coarser ``PREDICTION_STEP_S``) hold the targets within ``max_miss_m -
+The rounds 2-5 (at the coarser ``prediction_step_s``) hold the targets within ``max_miss_m -
 PREDICTION_MARGIN_M``; the verifying flight and the local repair within ``max_miss_m -
 VERIFY_MARGIN_M``.
 
@@ -50,42 +50,97 @@ from __future__ import annotations
 import math
 import os
 from concurrent.futures import ThreadPoolExecutor
-from dataclasses import dataclass, replace
+from dataclasses import dataclass
 from typing import Callable
 
 import numpy as np
 
 from ..autopilot.commands import Command
-from ..autopilot.navigation import (CALM, FLIGHT_LIMIT_S, MODEL_STEP_S, Airframe, LocalItem, MissionArrays,
-                                    MissionFlight, Wind)
+from ..autopilot.navigation import (CALM, FLIGHT_LIMIT_S, MODEL_STEP_S, Airframe, LocalItem,
+                                    MissionArrays, MissionFlight, Wind)
 from .actions import loiter_turns_params
 from .model import FlightPath
 
-#: Prediction time step, s (the agreement with ArduPlane was measured at 0.02 s; 0.05 s
-#: changes predicted misses by a few decimetres and is 2.5 times faster).
-PREDICTION_STEP_S = 0.05
-#: A target's aim is corrected once its miss exceeds this fraction of the allowed miss.
-CORRECT_ABOVE = 0.5
-#: Aim corrections are tried at full size and halved each round they do not help; after
-#: ``IDLE_ROUNDS`` rounds in a row without ``PROGRESS`` (a fraction of the total miss beyond
-#: the allowed one) the targets still beyond get shaping waypoints.
-IDLE_ROUNDS = 2
-PROGRESS = 0.05
-#: A correction at a target is judged by its miss and the misses of this many targets after it
-#: (the track it moves settles again within a few L1 distances).
-AFFECTS_NEXT = 2
-#: Predicted flights a design may take (measured: 30 -> 50 holds 1 to 3 more targets of 100-272
-#: on the mission-items sites, about 3 s more on the bundled site).
-ROUNDS = 50
-#: A target beyond the allowed miss counts as missed by this fraction of the allowed miss more
-#: (measured on the eight sites of docs/mission-items.md: 1 instead of 0 leaves 31 instead of 41
-#: targets beyond 5 m, 16 instead of 24 on the 400-target clustered site, whose worst miss is
-#: 28.1 against 27.6 m).
-BEYOND_COST = 1.0
-#: A shaping waypoint goes into the longest stretch of the exact path among the waypoint gaps
-#: this many L1 distances before the stuck target: where the path turns that the autopilot
-#: could not follow (often before the previous target, when the two are close).
-LOOKBACK_L1 = 4.0
+
+@dataclass(frozen=True)
+class DesignTuning:
+    """The guidance design's tuning, passed in (``MissionSettings.tuning``): each value as
+    measured where its note says.  The defaults are the product's."""
+
+    #: Prediction time step, s (the agreement with ArduPlane was measured at 0.02 s; 0.05 s
+    #: changes predicted misses by a few decimetres and is 2.5 times faster).
+    prediction_step_s: float = 0.05
+    #: A target's aim is corrected once its miss exceeds this fraction of the allowed miss.
+    correct_above: float = 0.5
+    #: Aim corrections are tried at full size and halved each round they do not help; after
+    #: ``idle_rounds`` rounds in a row without ``progress`` (a fraction of the total miss beyond
+    #: the allowed one) the targets still beyond get shaping waypoints.
+    idle_rounds: int = 2
+    progress: float = 0.05
+    #: A correction at a target is judged by its miss and the misses of this many targets after it
+    #: (the track it moves settles again within a few L1 distances).
+    affects_next: int = 2
+    #: Predicted flights a design may take (measured: 30 -> 50 holds 1 to 3 more targets of 100-272
+    #: on the mission-items sites, about 3 s more on the bundled site).
+    rounds: int = 50
+    #: A target beyond the allowed miss counts as missed by this fraction of the allowed miss more
+    #: (measured on the eight sites of docs/mission-items.md: 1 instead of 0 leaves 31 instead of 41
+    #: targets beyond 5 m, 16 instead of 24 on the 400-target clustered site, whose worst miss is
+    #: 28.1 against 27.6 m).
+    beyond_cost: float = 1.0
+    #: A shaping waypoint goes into the longest stretch of the exact path among the waypoint gaps
+    #: this many L1 distances before the stuck target: where the path turns that the autopilot
+    #: could not follow (often before the previous target, when the two are close).
+    lookback_l1: float = 4.0
+    #: An arc of the exact path turning more than this is a loop the guidance does not fly from
+    #: its ends alone (it cuts inside, the wrong way round): it gets waypoints on it from the start.
+    loop_min_rad: float = math.pi
+    #: Spacing of those waypoints along the loop, as turn angle.
+    loop_step_rad: float = math.pi / 2
+    #: The local repair: a target still beyond is re-flown from ``local_back`` waypoints before it
+    #: to ``local_ahead`` after it, moving the waypoints ``local_move`` before it and its own, in at
+    #: most ``local_trials`` short flights; a change is kept only if the whole mission flown again
+    #: is better.  The flight resumes one waypoint before the first one moved: a waypoint's
+    #: position already decides when the one before it is reached (its turn angle scales the
+    #: acceptance radius) and when a loiter before it is left.
+    local_back: int = 3
+    local_ahead: int = 3
+    local_move: int = 2
+    local_trials: int = 40
+    local_min_step_m: float = 0.25
+    #: A target the pattern search leaves beyond can get up to this many other starts (seeded by
+    #: its place in the mission; the first that holds it ends them), every movable waypoint
+    #: anywhere within ``local_spread_m`` east and north of where it was; the pattern search goes
+    #: on from the best of them if it is better than where it started.  Off by default: measured
+    #: (docs/mission-items.md) before ``local_reset``, 100 starts took the 400-target clustered
+    #: site from 4 to 2 targets beyond (worst 22.6 -> 17.4 m) and held the bundled site at 1.3
+    #: rho instead of 1.6 (27.4 instead of 32.4 km, 1.12 instead of 1.24 items per target), but
+    #: doubled the design time (bundled site 371 s against 145 s).
+    local_starts: int = 0
+    local_spread_m: float = 40.0
+    #: A target the pattern search leaves beyond gets one more search, from the movable waypoints
+    #: of targets put back on their targets: the repair's corrections of neighbouring waypoints
+    #: pile up (each moved to pass its own target) where no small step undoes them.  Measured on
+    #: the 400-target clustered site at 1.6 rho: the local repair ends with 0 targets beyond
+    #: instead of 4 (worst 22.6 m), in 114 s instead of 96 s (the local repair alone, from the
+    #: same repaired design; whole sites in docs/mission-items.md).
+    local_reset: bool = True
+    #: Passes of the local repair over the targets still beyond (it stops early when one gains
+    #: nothing).
+    refine_passes: int = 3
+    #: The repair holds the targets this much closer than asked: its predictions (0.05 s steps)
+    #: differ from the verifying flight's by up to 1.5 m (bundled site), mostly under half a metre.
+    prediction_margin_m: float = 0.5
+    #: The local repair flies at the step of the verifying flight (the one the model's agreement
+    #: with ArduPlane was measured at, which `fly` and `predict_flight` fly too), and holds the
+    #: targets this much inside ``max_miss_m``.
+    verify_step_s: float = MODEL_STEP_S
+    verify_margin_m: float = 0.05
+    #: Turns of a loiter the design flies: the later ones repeat the last (their length is added).
+    design_loiter_turns: int = 2
+    #: The wider turn radii (times the one asked for) the whole tour is planned again with,
+    #: in turn, when the design at the radius asked for does not hold every target.
+    guidance_margins: tuple[float, ...] = (1.3, 1.6)
 
 
 def _shaping_gap(s_wp: list[float], k: int, lookback_m: float,
@@ -131,20 +186,18 @@ class GuidanceDesign:
 
 
 def _fly(items: list[LocalItem], airframe: Airframe, heading_rad: float, stop_after_seq: int,
-         targets_m: np.ndarray, wind: Wind = CALM
+         targets_m: np.ndarray, wind: Wind = CALM, step_s: float = DesignTuning.prediction_step_s
          ) -> tuple[np.ndarray, dict[int, float], np.ndarray, float]:
     """Track rows (time, x, y), reach times, each target's closest approach after the take-off
     (``targets_m`` in the flight's frame) and the length flown from the take-off's end, until
     item ``stop_after_seq`` is reached."""
     flight = MissionFlight(items, airframe, heading_rad, 1, wind)
-    run = flight.run(PREDICTION_STEP_S, stop_after_seq, points_m=targets_m,
+    run = flight.run(step_s, stop_after_seq, points_m=targets_m,
                      measure_from_seq=_AFTER_TAKEOFF, until_s=FLIGHT_LIMIT_S)
     track = np.vstack([np.zeros((1, 3)), run.track[:, :3]])
     return track, dict(flight.reached), run.closest_m, run.measured_length_m
 
 
-#: Turns of a loiter the design flies: the later ones repeat the last (their length is added).
-DESIGN_LOITER_TURNS = 2
 #: The first item after the take-off (seq 1): the misses and length count from it.
 _AFTER_TAKEOFF = 2
 
@@ -184,25 +237,20 @@ def _local_items(takeoff_m: np.ndarray, takeoff_alt_m: float, head_items, aim_m:
     return items, seqs
 
 
-#: An arc of the exact path turning more than this is a loop the guidance does not fly from
-#: its ends alone (it cuts inside, the wrong way round): it gets waypoints on it from the start.
-LOOP_MIN_RAD = math.pi
-#: Spacing of those waypoints along the loop, as turn angle.
-LOOP_STEP_RAD = math.pi / 2
 
 
-def _loop_waypoints(path: FlightPath, room: int) -> np.ndarray:
+def _loop_waypoints(path: FlightPath, room: int, tuning: DesignTuning) -> np.ndarray:
     """Arc lengths of waypoints on the loops of the tour part of ``path`` (arcs turning more
-    than :data:`LOOP_MIN_RAD`), every :data:`LOOP_STEP_RAD` of turn, at most ``room``."""
+    than ``loop_min_rad``), every ``loop_step_rad`` of turn, at most ``room``."""
     chain = path.chain
     offsets = chain.offsets_m
     turn = np.abs(chain.curvatures_1_m) * chain.lengths_m
     chosen = []
-    for k in np.flatnonzero(turn > LOOP_MIN_RAD):
+    for k in np.flatnonzero(turn > tuning.loop_min_rad):
         start = offsets[k]
         if start < path.tour_start_s_m - 1e-9 or start > path.tour_end_s_m:
             continue
-        count = int(math.ceil(turn[k] / LOOP_STEP_RAD)) - 1
+        count = int(math.ceil(turn[k] / tuning.loop_step_rad)) - 1
         step = chain.lengths_m[k] / (count + 1)
         chosen += [start + step * (j + 1) for j in range(count)]
     chosen = np.asarray(chosen, dtype=float)
@@ -223,10 +271,11 @@ class _Trial:
     corrections: dict[int, np.ndarray]   # per target: where the track should have been moved
 
     @staticmethod
-    def cost_of(miss_m: np.ndarray, max_miss_m: float) -> np.ndarray:
-        """Per target, its miss beyond ``max_miss_m`` and ``BEYOND_COST`` of it if beyond."""
+    def cost_of(miss_m: np.ndarray, max_miss_m: float,
+                beyond_cost: float = DesignTuning.beyond_cost) -> np.ndarray:
+        """Per target, its miss beyond ``max_miss_m`` and ``beyond_cost`` of it if beyond."""
         excess = np.maximum(miss_m - max_miss_m, 0.0)
-        return excess + BEYOND_COST * max_miss_m * (excess > 0.0)
+        return excess + beyond_cost * max_miss_m * (excess > 0.0)
 
     @property
     def total(self) -> float:
@@ -250,48 +299,6 @@ def _with_shaping(trial: _Trial, targets: list[int], lookback_m: float,
     return fly(s_wp, target_of, offsets)
 
 
-#: The local repair: a target still beyond is re-flown from ``LOCAL_BACK`` waypoints before it
-#: to ``LOCAL_AHEAD`` after it, moving the waypoints ``LOCAL_MOVE`` before it and its own, in at
-#: most ``LOCAL_TRIALS`` short flights; a change is kept only if the whole mission flown again
-#: is better.  The flight resumes one waypoint before the first one moved: a waypoint's
-#: position already decides when the one before it is reached (its turn angle scales the
-#: acceptance radius) and when a loiter before it is left.
-LOCAL_BACK = 3
-LOCAL_AHEAD = 3
-LOCAL_MOVE = 2
-LOCAL_TRIALS = 40
-LOCAL_MIN_STEP_M = 0.25
-#: A target the pattern search leaves beyond can get up to this many other starts (seeded by
-#: its place in the mission; the first that holds it ends them), every movable waypoint
-#: anywhere within ``LOCAL_SPREAD_M`` east and north of where it was; the pattern search goes
-#: on from the best of them if it is better than where it started.  Off by default: measured
-#: (docs/mission-items.md) before ``LOCAL_RESET``, 100 starts took the 400-target clustered
-#: site from 4 to 2 targets beyond (worst 22.6 -> 17.4 m) and held the bundled site at 1.3
-#: rho instead of 1.6 (27.4 instead of 32.4 km, 1.12 instead of 1.24 items per target), but
-#: doubled the design time (bundled site 371 s against 145 s).
-LOCAL_STARTS = 0
-LOCAL_SPREAD_M = 40.0
-#: A target the pattern search leaves beyond gets one more search, from the movable waypoints
-#: of targets put back on their targets: the repair's corrections of neighbouring waypoints
-#: pile up (each moved to pass its own target) where no small step undoes them.  Measured on
-#: the 400-target clustered site at 1.6 rho: the local repair ends with 0 targets beyond
-#: instead of 4 (worst 22.6 m), in 114 s instead of 96 s (the local repair alone, from the
-#: same repaired design; whole sites in docs/mission-items.md).
-LOCAL_RESET = True
-#: Passes of the local repair over the targets still beyond (it stops early when one gains
-#: nothing).
-REFINE_PASSES = 3
-#: The repair holds the targets this much closer than asked: its predictions (0.05 s steps)
-#: differ from the verifying flight's by up to 1.5 m (bundled site), mostly under half a metre.
-PREDICTION_MARGIN_M = 0.5
-#: The local repair flies at the step of the verifying flight (the one the model's agreement
-#: with ArduPlane was measured at, which `fly` and `predict_flight` fly too), and holds the
-#: targets this much inside ``max_miss_m``.
-VERIFY_STEP_S = MODEL_STEP_S
-#: The local repair's pattern search judges its trials at this step (a change it keeps is
-#: judged again at ``VERIFY_STEP_S`` over the rest of the mission).
-SEARCH_STEP_S = PREDICTION_STEP_S
-VERIFY_MARGIN_M = 0.05
 
 
 _POOL: ThreadPoolExecutor | None = None
@@ -324,10 +331,10 @@ def _judged(misses: list[np.ndarray], spread_margin_m: float) -> np.ndarray:
 def _refine(aim: np.ndarray, target_of: list[int], items: list[LocalItem], seqs: list[int],
             home: np.ndarray, targets_m: np.ndarray, max_miss_m: float, airframe: Airframe,
             heading: float, stored: Callable[[np.ndarray], np.ndarray],
-            winds: tuple[Wind, ...] = (CALM,), spread_margin_m: float = 0.0
-            ) -> tuple[np.ndarray, np.ndarray, float, int]:
+            winds: tuple[Wind, ...] = (CALM,), spread_margin_m: float = 0.0,
+            tuning: DesignTuning = DesignTuning()) -> tuple[np.ndarray, np.ndarray, float, int]:
     """(aims, per-target miss, predicted length, whole flights) after up to
-    :data:`REFINE_PASSES` passes of the local repair over the targets still beyond
+    ``refine_passes`` passes of the local repair over the targets still beyond
     ``max_miss_m``, in visit order, each from the design as repaired so far.  A target's miss
     is :func:`_judged` over ``winds`` (each flown; the first is the forecast, whose flight
     gives the length).  A change is kept only if the mission flown on with it from its checkpoints
@@ -342,29 +349,30 @@ def _refine(aim: np.ndarray, target_of: list[int], items: list[LocalItem], seqs:
 
     def afresh(mission: MissionArrays):
         runs = _each(lambda wind: MissionFlight(mission, airframe, heading, 1, wind).run(
-                         VERIFY_STEP_S, last, marks=seq_set, points_m=local_targets,
+                         tuning.verify_step_s, last, marks=seq_set, points_m=local_targets,
                          measure_from_seq=_AFTER_TAKEOFF, track=False, until_s=FLIGHT_LIMIT_S),
                      winds)
         miss = _judged([run.closest_m for run in runs], spread_margin_m)
         marks = {seq: [run.checkpoints[seq] for run in runs] for seq in runs[0].checkpoints
                  if all(seq in run.checkpoints for run in runs)}
-        return marks, miss, runs[0].measured_length_m, _Trial.cost_of(miss, max_miss_m)
+        cost = _Trial.cost_of(miss, max_miss_m, tuning.beyond_cost)
+        return marks, miss, runs[0].measured_length_m, cost
 
     marks, miss, length, cost = afresh(mission)
     flights = 1
     aim = aim.copy()
     best = (aim, miss, length, cost.sum())
-    for _ in range(REFINE_PASSES):
+    for _ in range(tuning.refine_passes):
         before_pass = cost.sum()
         if before_pass <= 0.0:
             break
         for k, t in enumerate(target_of):
             if t < 0 or cost[t] <= 0.0:
                 continue
-            begin, end = max(k - LOCAL_BACK, 0), min(k + LOCAL_AHEAD, len(seqs) - 1)
+            begin, end = max(k - tuning.local_back, 0), min(k + tuning.local_ahead, len(seqs) - 1)
             checkpoints = marks[seqs[begin]]
             window = [target_of[j] for j in range(begin, end + 1) if target_of[j] >= 0]
-            movable = list(range(max(k - LOCAL_MOVE, begin + 1 if begin > 0 else 0), k + 1))
+            movable = list(range(max(k - tuning.local_move, begin + 1 if begin > 0 else 0), k + 1))
             movable_index = np.array([seqs[j] for j in movable], dtype=np.int64)
 
             def with_aims(points: np.ndarray) -> MissionArrays:
@@ -373,20 +381,21 @@ def _refine(aim: np.ndarray, target_of: list[int], items: list[LocalItem], seqs:
             def local_cost(points: np.ndarray) -> float:
                 changed = with_aims(points)
                 worst = _judged(_each(lambda checkpoint: checkpoint.flight.copy(changed).run(
-                    VERIFY_STEP_S, seqs[end], track=False, points_m=local_targets[window],
+                    tuning.verify_step_s, seqs[end], track=False, points_m=local_targets[window],
                     closest_m=checkpoint.closest_m[window], measure_from_seq=_AFTER_TAKEOFF,
                     until_s=FLIGHT_LIMIT_S).closest_m, checkpoints), spread_margin_m)
-                return float(_Trial.cost_of(worst, max_miss_m).sum())
+                return float(_Trial.cost_of(worst, max_miss_m, tuning.beyond_cost).sum())
 
             def descend(candidate: np.ndarray, current: float, step_m: float
                         ) -> tuple[np.ndarray, float]:
                 """Pattern search from ``candidate``: the best aims found and their cost."""
                 trials = 0
-                while trials < LOCAL_TRIALS and step_m >= LOCAL_MIN_STEP_M and current > 0.0:
+                while (trials < tuning.local_trials and step_m >= tuning.local_min_step_m
+                       and current > 0.0):
                     best_move, best_cost = None, current
                     for j in movable:
                         for direction in ((1, 0), (-1, 0), (0, 1), (0, -1)):
-                            if trials >= LOCAL_TRIALS:
+                            if trials >= tuning.local_trials:
                                 break
                             moved = candidate.copy()
                             moved[j] = stored((moved[j] + step_m * np.asarray(direction))[None])[0]
@@ -403,7 +412,7 @@ def _refine(aim: np.ndarray, target_of: list[int], items: list[LocalItem], seqs:
             first_step_m = max(min(miss[t] - max_miss_m, 10.0), 1.0)
             initial = local_cost(aim)
             candidate, current = descend(aim.copy(), initial, first_step_m)
-            if current > 0.0 and LOCAL_RESET:
+            if current > 0.0 and tuning.local_reset:
                 reset = aim.copy()
                 on = [j for j in movable if target_of[j] >= 0]
                 reset[on] = stored(targets_m[[target_of[j] for j in on]])
@@ -413,13 +422,13 @@ def _refine(aim: np.ndarray, target_of: list[int], items: list[LocalItem], seqs:
                         candidate, current = other, other_cost
             if current > 0.0:
                 # The repair's corrections can leave the waypoints where no small step helps:
-                # other starts, the movable waypoints each anywhere within LOCAL_SPREAD_M.
+                # other starts, the movable waypoints each anywhere within local_spread_m.
                 rng = np.random.default_rng(k)
                 best_start, best_cost = None, initial
-                for _ in range(LOCAL_STARTS):
+                for _ in range(tuning.local_starts):
                     moved = aim.copy()
                     moved[movable] = stored(aim[movable] + rng.uniform(
-                        -LOCAL_SPREAD_M, LOCAL_SPREAD_M, (len(movable), 2)))
+                        -tuning.local_spread_m, tuning.local_spread_m, (len(movable), 2)))
                     c = local_cost(moved)
                     if c < best_cost:
                         best_start, best_cost = moved, c
@@ -434,12 +443,13 @@ def _refine(aim: np.ndarray, target_of: list[int], items: list[LocalItem], seqs:
             changed = with_aims(candidate)
             later = {q for q in seq_set if q >= seqs[begin]}
             runs = _each(lambda checkpoint: checkpoint.flight.copy(changed).run(
-                             VERIFY_STEP_S, last, track=False, marks=later, points_m=local_targets,
+                             tuning.verify_step_s, last, track=False, marks=later,
+                             points_m=local_targets,
                              closest_m=checkpoint.closest_m, measure_from_seq=_AFTER_TAKEOFF,
                              until_s=FLIGHT_LIMIT_S), checkpoints)
             flights += 1
             new_miss = _judged([run.closest_m for run in runs], spread_margin_m)
-            new_cost = _Trial.cost_of(new_miss, max_miss_m)
+            new_cost = _Trial.cost_of(new_miss, max_miss_m, tuning.beyond_cost)
             if new_cost.sum() < cost.sum():
                 aim, mission = candidate, changed
                 miss, length, cost = new_miss, runs[0].measured_length_m, new_cost
@@ -461,8 +471,8 @@ def design_waypoints(path: FlightPath, targets_m: np.ndarray, altitudes_m: np.nd
                      target_acceptance_m: float = 5.0, rounds: int | None = None,
                      progress: Callable[[int, int], None] | None = None,
                      as_stored: Callable[[np.ndarray], np.ndarray] | None = None,
-                     winds: tuple[Wind, ...] = (CALM,), spread_margin_m: float = 0.0
-                     ) -> GuidanceDesign:
+                     winds: tuple[Wind, ...] = (CALM,), spread_margin_m: float = 0.0,
+                     tuning: DesignTuning = DesignTuning()) -> GuidanceDesign:
     """The waypoints (``budget`` at most) that make the modelled autopilot pass every target
     of ``path`` within ``max_miss_m``, as far as ``rounds`` predicted flights of the repair and
     the local repair's passes allow.
@@ -480,30 +490,30 @@ def design_waypoints(path: FlightPath, targets_m: np.ndarray, altitudes_m: np.nd
     """
     home = path.climb_start_m
     stored = as_stored if as_stored is not None else (lambda points: points)
-    repair_miss_m = max(max_miss_m - PREDICTION_MARGIN_M, 0.5 * max_miss_m)
+    repair_miss_m = max(max_miss_m - tuning.prediction_margin_m, 0.5 * max_miss_m)
     order = np.argsort(path.target_s_m, kind="stable")
     s_wp = list(path.target_s_m[order])
     target_of = list(order)
-    for s in _loop_waypoints(path, budget - len(s_wp)):
+    for s in _loop_waypoints(path, budget - len(s_wp), tuning):
         k = int(np.searchsorted(s_wp, s))
         s_wp.insert(k, float(s))
         target_of.insert(k, -1)
     takeoff = path.chain.pose_at(np.array([0.0]))[0, :2] - home
     heading = math.atan2(takeoff[1], takeoff[0])
-    lookback_m = LOOKBACK_L1 * airframe.l1_distance_m(airframe.airspeed_m_s)
-    # The design flies each loiter's first DESIGN_LOITER_TURNS turns: later turns repeat the
+    lookback_m = tuning.lookback_l1 * airframe.l1_distance_m(airframe.airspeed_m_s)
+    # The design flies each loiter's first design_loiter_turns turns: later turns repeat the
     # last one (same circle, same exit), so they add their length and change no miss.
     loiters = {span.target: (float(span.centre_m[0] - home[0]), float(span.centre_m[1] - home[1]),
-                             loiter_turns_params(min(span.turns, DESIGN_LOITER_TURNS),
+                             loiter_turns_params(min(span.turns, tuning.design_loiter_turns),
                                                  span.radius_m, span.clockwise))
                for span in path.loiters}
     # The flights end with the last target's loiter, if it has one: so does the plan compared.
     planned_end_s = max([float(path.target_s_m.max())] + [span.end_s_m for span in path.loiters])
-    skipped_m = sum(2.0 * math.pi * span.radius_m * max(span.turns - DESIGN_LOITER_TURNS, 0)
+    skipped_m = sum(2.0 * math.pi * span.radius_m * max(span.turns - tuning.design_loiter_turns, 0)
                     for span in path.loiters)
     loiter_ends = {float(span.start_s_m): float(span.end_s_m) for span in path.loiters}
     takeoff_alt = float(path.altitude_m(np.array([0.0]))[0])
-    rounds = ROUNDS if rounds is None else rounds
+    rounds = tuning.rounds if rounds is None else rounds
     rank = np.empty(len(order), dtype=int)          # each target's place in the visit order
     rank[order] = np.arange(len(order))
     flights = 0
@@ -520,7 +530,7 @@ def design_waypoints(path: FlightPath, targets_m: np.ndarray, altitudes_m: np.nd
                                    path.altitude_m(np.asarray(s_wp)), target_of,
                                    target_acceptance_m, loiters)
         track, reached, miss, predicted = _fly(items, airframe, heading, len(items) - 2,
-                                               targets_m - home, winds[0])
+                                               targets_m - home, winds[0], tuning.prediction_step_s)
         flown = track[:, 1:] + home
         after_takeoff = track[:, 0] >= reached.get(1, 0.0)
         start_s = reached.get(1, 0.0)
@@ -528,7 +538,7 @@ def design_waypoints(path: FlightPath, targets_m: np.ndarray, altitudes_m: np.nd
                                 predicted + skipped_m, planned_end_s, flights)
         corrections = {}
         for k, t in enumerate(target_of):       # the track near each target's own leg
-            if t < 0 or miss[t] <= CORRECT_ABOVE * repair_miss_m:
+            if t < 0 or miss[t] <= tuning.correct_above * repair_miss_m:
                 continue
             begin = reached.get(seqs[k] - 1, start_s)
             end = reached.get(seqs[k] + 1, track[-1, 0])
@@ -537,12 +547,12 @@ def design_waypoints(path: FlightPath, targets_m: np.ndarray, altitudes_m: np.nd
                 window = after_takeoff
             corrections[t] = targets_m[t] - _nearest_in(flown[window], targets_m[t])
         return _Trial(list(s_wp), list(target_of), dict(offsets), design,
-                      _Trial.cost_of(miss, repair_miss_m), corrections)
+                      _Trial.cost_of(miss, repair_miss_m, tuning.beyond_cost), corrections)
 
     def local(trial: _Trial, t: int) -> float:
         """Cost at target t and the next targets it affects (visit order)."""
         k = rank[t]
-        return float(trial.cost[order[k:k + AFFECTS_NEXT + 1]].sum())
+        return float(trial.cost[order[k:k + tuning.affects_next + 1]].sum())
 
     best = current = fly(s_wp, target_of, {int(t): np.zeros(2) for t in order})
     step, idle = 1.0, 0
@@ -560,12 +570,12 @@ def design_waypoints(path: FlightPath, targets_m: np.ndarray, altitudes_m: np.nd
                             {t: proposal[t] if t in kept else current.offsets[t]
                              for t in current.offsets})
         if trial.total < current.total:
-            idle = 0 if trial.total < (1.0 - PROGRESS) * current.total else idle + 1
+            idle = 0 if trial.total < (1.0 - tuning.progress) * current.total else idle + 1
             current = trial
             best = trial if trial.total < best.total else best
         else:
             step, idle = 0.5 * step, idle + 1
-        if idle < IDLE_ROUNDS or flights >= rounds:
+        if idle < tuning.idle_rounds or flights >= rounds:
             continue
         # Corrections no longer help: a shaping waypoint before each target still beyond;
         # the corrections go on from there (the best design flown is kept).
@@ -581,10 +591,10 @@ def design_waypoints(path: FlightPath, targets_m: np.ndarray, altitudes_m: np.nd
     items, seqs = _local_items(takeoff, takeoff_alt, head_items, design.aim_m - home,
                                path.altitude_m(design.s_m), best.target_of,
                                target_acceptance_m, loiters)
-    verify_miss_m = max(max_miss_m - VERIFY_MARGIN_M, 0.5 * max_miss_m)
+    verify_miss_m = max(max_miss_m - tuning.verify_margin_m, 0.5 * max_miss_m)
     aim, miss, length, flown = _refine(design.aim_m, best.target_of, items, seqs, home,
                                        targets_m, verify_miss_m, airframe, heading, stored, winds,
-                                       spread_margin_m)
+                                       spread_margin_m, tuning)
     flights += flown
     if progress is not None:
         progress(min(flights, rounds), rounds)
@@ -593,7 +603,7 @@ def design_waypoints(path: FlightPath, targets_m: np.ndarray, altitudes_m: np.nd
                             loiters)
     misses = [run.closest_m for run in _each(
         lambda wind: MissionFlight(final, airframe, heading, 1, wind).run(
-            VERIFY_STEP_S, len(final) - 2, points_m=targets_m - home, track=False,
+            tuning.verify_step_s, len(final) - 2, points_m=targets_m - home, track=False,
             measure_from_seq=_AFTER_TAKEOFF, until_s=FLIGHT_LIMIT_S), winds)]
     return GuidanceDesign(design.s_m, aim, design.target_of, misses[0], length + skipped_m,
                           design.planned_length_m, flights + len(winds),

@@ -12,7 +12,7 @@ import pytest
 from dtsp_mission.autopilot.navigation import Airframe, closest_approach_m
 from dtsp_mission.errors import InputError, MissionTooLarge
 from dtsp_mission.frame import LocalFrame
-from dtsp_mission.mission import MissionSettings, build_mission
+from dtsp_mission.mission import DesignTuning, MissionSettings, build_mission
 from dtsp_mission.mission.build import check_storage
 from dtsp_mission.planning import get_planner
 from dtsp_mission.sim.predict import predict_flight
@@ -107,19 +107,18 @@ def _fence(rho_m: float):
     return tour, frame, local_targets(points).to_geodetic(frame)
 
 
-def test_loops_of_the_exact_path_get_waypoints_and_are_flown_round(monkeypatch):
+def test_loops_of_the_exact_path_get_waypoints_and_are_flown_round():
     """ArduPlane given only a loop's ends cuts inside it, the wrong way round, and misses the
     posts after it (the bundled site's fence corners); waypoints on the loop make it fly the
     loop: as first designed (one predicted flight, before any repair), fewer targets beyond
     the limit, a smaller worst miss, a predicted flight closer to the planned one."""
-    import dtsp_mission.mission.guidance as guidance
     tour, frame, targets = _fence(104.0)
-    settings = MissionSettings(design="guidance", airspeed_m_s=22.0, altitude_m=120.0)
-    monkeypatch.setattr(guidance, "ROUNDS", 1)
-    monkeypatch.setattr(guidance, "REFINE_PASSES", 0)
+    first_flight = DesignTuning(rounds=1, refine_passes=0)
+    settings = MissionSettings(design="guidance", airspeed_m_s=22.0, altitude_m=120.0,
+                               tuning=first_flight)
     looped = build_mission(tour, frame, targets, settings)
-    monkeypatch.setattr(guidance, "LOOP_MIN_RAD", float("inf"))
-    bare = build_mission(tour, frame, targets, settings)
+    bare = build_mission(tour, frame, targets, replace(settings, tuning=replace(
+        first_flight, loop_min_rad=float("inf"))))
 
     def figures(mission):
         miss = np.array(mission.summary["predicted_miss_m"])
@@ -131,10 +130,9 @@ def test_loops_of_the_exact_path_get_waypoints_and_are_flown_round(monkeypatch):
     assert looped.summary["items"] > bare.summary["items"]          # the loop waypoints
 
 
-def test_the_repair_keeps_only_what_the_model_flew_better(monkeypatch):
+def test_the_repair_keeps_only_what_the_model_flew_better():
     """The repair rounds never return a design the model predicts worse than the first one,
     and on the fence they hold more posts than it."""
-    import dtsp_mission.mission.guidance as guidance
     tour, frame, targets = _fence(104.0)
     settings = MissionSettings(design="guidance", airspeed_m_s=22.0, altitude_m=120.0)
 
@@ -143,9 +141,8 @@ def test_the_repair_keeps_only_what_the_model_flew_better(monkeypatch):
         limit = settings.design_limit_m
         return float(np.maximum(miss - limit, 0.0).sum()), int((miss > limit).sum())
     repaired = build_mission(tour, frame, targets, settings)
-    monkeypatch.setattr(guidance, "ROUNDS", 1)
-    monkeypatch.setattr(guidance, "REFINE_PASSES", 0)
-    first = build_mission(tour, frame, targets, settings)
+    first = build_mission(tour, frame, targets, replace(
+        settings, tuning=DesignTuning(rounds=1, refine_passes=0)))
     assert excess(repaired)[0] < excess(first)[0] and excess(repaired)[1] < excess(first)[1]
     assert 2 < repaired.summary["design_rounds"]
     # one predicted flight, the verifying one, then the design flown in each design wind
@@ -181,24 +178,24 @@ def test_a_flight_copied_midway_goes_on_exactly_as_the_original():
     assert len(flight.reached) > frozen[3]          # it went on past more waypoints
 
 
-def test_the_local_repair_holds_more_and_reports_what_the_mission_flies(monkeypatch):
+def test_the_local_repair_holds_more_and_reports_what_the_mission_flies():
     """The local repair (short flights from checkpoints) ends with fewer targets beyond than
     the global repair, and the misses it reports are those of the written mission flown again
     from the start at the model's step."""
-    import dtsp_mission.mission.guidance as guidance
     tour, frame, targets = _fence(80.0)
-    settings = MissionSettings(design="guidance", airspeed_m_s=22.0, altitude_m=120.0)
-    monkeypatch.setattr(guidance, "ROUNDS", 8)
+    eight = DesignTuning(rounds=8)
+    settings = MissionSettings(design="guidance", airspeed_m_s=22.0, altitude_m=120.0,
+                               tuning=eight)
     repaired = build_mission(tour, frame, targets, settings)
-    monkeypatch.setattr(guidance, "REFINE_PASSES", 0)
-    unrepaired = build_mission(tour, frame, targets, settings)
+    unrepaired = build_mission(tour, frame, targets, replace(
+        settings, tuning=replace(eight, refine_passes=0)))
     limit = settings.design_limit_m
     held = np.array(repaired.summary["predicted_miss_m"])          # in the forecast (calm) air
     before = np.array(unrepaired.summary["judged_miss_m"])
     assert (before > limit).sum() > 0
     assert (np.array(repaired.summary["judged_miss_m"]) > limit).sum() < (before > limit).sum()
     flight = predict_flight(repaired.for_vehicle(), Airframe.from_parameters(airspeed_m_s=22.0),
-                            guidance.VERIFY_STEP_S)
+                            eight.verify_step_s)
     after = flight.track[:, 0] >= flight.reached[1]
     xy = flight.frame.to_local(targets.latitudes_deg, targets.longitudes_deg)
     flown = closest_approach_m(flight.track[after, 1:3], xy)
@@ -235,21 +232,19 @@ def test_the_turn_margin_keeps_a_design_that_holds_and_otherwise_ranks_by_the_fl
 
 
 @pytest.mark.heavy(seconds=29)
-def test_the_local_repair_s_other_starts_hold_what_small_steps_cannot(monkeypatch):
+def test_the_local_repair_s_other_starts_hold_what_small_steps_cannot():
     """After four repair rounds on the fence (forecast wind only), the local repair's pattern
     search (from the repaired aims and from the targets) leaves a post beyond the design
     limit; given 100 seeded random starts (off by default) it holds every post, and the same
     input gives the same mission.  (The starts are a heuristic, not a guarantee: after six or
     eight rounds they leave two posts beyond where the search alone leaves one or none.)"""
-    import dtsp_mission.mission.guidance as guidance
     from dtsp_mission.mission.build import targets_beyond as beyond
     tour, frame, targets = _fence(80.0)
     settings = MissionSettings(design="guidance", airspeed_m_s=22.0, altitude_m=120.0,
-                               wind_spread_m_s=0.0)
-    monkeypatch.setattr(guidance, "ROUNDS", 4)
+                               wind_spread_m_s=0.0, tuning=DesignTuning(rounds=4))
     alone = build_mission(tour, frame, targets, settings)
     assert beyond(alone) > 0
-    monkeypatch.setattr(guidance, "LOCAL_STARTS", 100)
+    settings = replace(settings, tuning=DesignTuning(rounds=4, local_starts=100))
     started = build_mission(tour, frame, targets, settings)
     assert build_mission(tour, frame, targets, settings).items == started.items
     assert beyond(started) == 0
@@ -267,24 +262,22 @@ def _clustered(count: int, seed: int):
 
 
 @pytest.mark.heavy(seconds=60)
-def test_the_local_repair_starts_again_from_the_targets_where_corrections_piled_up(monkeypatch):
+def test_the_local_repair_starts_again_from_the_targets_where_corrections_piled_up():
     """On a clustered site (80 targets, seed 2, rho 80 m; forecast wind only) the pattern
     search from the repaired aims leaves a target beyond the design limit: the corrections of
     neighbouring waypoints, each moved to pass its own target, hold each other where no small
     step helps.  Searched again from those waypoints put back on their targets, every target
     is held.  (A heuristic: over seeds 0-3 at rho 80 and 104 it leaves 14 targets beyond with
     the second search and 14 without.)"""
-    import dtsp_mission.mission.guidance as guidance
     from dtsp_mission.api import plan_tour
     from dtsp_mission.mission.build import targets_beyond
     targets = _clustered(80, 2)
     tour, frame = plan_tour(targets, 80.0)
     settings = MissionSettings(design="guidance", airspeed_m_s=22.0, altitude_m=120.0,
                                home_deg=CENTRE, wind_spread_m_s=0.0)
-    monkeypatch.setattr(guidance, "LOCAL_RESET", False)
-    stuck = build_mission(tour, frame, targets, settings)
-    monkeypatch.setattr(guidance, "LOCAL_RESET", True)
-    held = build_mission(tour, frame, targets, settings)
+    stuck = build_mission(tour, frame, targets, replace(
+        settings, tuning=DesignTuning(local_reset=False)))
+    held = build_mission(tour, frame, targets, settings)      # local_reset by default
     assert targets_beyond(stuck) > 0 and targets_beyond(held) == 0
     assert len(held.items) == len(stuck.items)          # the same waypoints, placed otherwise
 
