@@ -60,6 +60,8 @@ def targets_from(geodetic) -> Targets:
                    altitudes, tuple(names))
 
 
+#: A simulated vehicle that sends no telemetry for this long has stopped (s, wall clock).
+SILENCE_S = 20.0
 #: A target farther than this from every position of a mission was not planned with it.
 FAR_FROM_MISSION_M = 5_000.0
 
@@ -197,12 +199,20 @@ def _watch(vehicle: SimulatedVehicle, connection: str, mission: VehicleMission, 
         ack = link.recv_match(type="COMMAND_ACK", blocking=True, timeout=5)
         if ack is None or ack.result != 0:
             raise LinkError("the simulated vehicle did not start the mission")
-        budget = timeout_s or 60.0 + 4 * 3600 / max(speedup, 1.0) + len(mission.items)
+        airframe = vehicle.settings.airframe
+        flight_s = estimated_flight_m(mission, airframe.loiter_radius_m) / airframe.airspeed_m_s
+        # Twice the estimated flight (at least 4 h of it) at the speed-up, and time to start.
+        budget = timeout_s or (60.0 + 2 * max(flight_s, 7200.0) / max(speedup, 1.0)
+                               + len(mission.items))
         deadline = time.monotonic() + budget
-        last_heartbeat = 0.0
+        last_heartbeat = last_heard = time.monotonic()
         while highest < last_seq:
-            if time.monotonic() > deadline:
+            now = time.monotonic()
+            if now > deadline:
                 raise LinkError(f"the simulated flight did not finish within {budget:.0f} s "
+                                f"(reached item {highest} of {last_seq})")
+            if now - last_heard > SILENCE_S:
+                raise LinkError(f"the simulated vehicle sent nothing for {SILENCE_S:g} s "
                                 f"(reached item {highest} of {last_seq})")
             if time.monotonic() - last_heartbeat > 1.0:
                 link.mav.heartbeat_send(6, 8, 0, 0, 0)
@@ -211,6 +221,7 @@ def _watch(vehicle: SimulatedVehicle, connection: str, mission: VehicleMission, 
                                       blocking=True, timeout=0.5)
             if message is None:
                 continue
+            last_heard = time.monotonic()
             if message.get_type() == "GLOBAL_POSITION_INT":
                 rows.append((message.lat / 1e7, message.lon / 1e7, message.relative_alt / 1e3,
                              message.vx / 100.0, message.vy / 100.0))

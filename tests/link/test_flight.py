@@ -62,3 +62,14 @@ def test_closest_approach_is_exact_on_segments():
     track = np.array([[0.0, 0.0], [10.0, 0.0], [10.0, 10.0]])
     points = np.array([[5.0, 3.0], [12.0, 5.0], [-4.0, -3.0]])
     assert closest_approach_m(track, points) == pytest.approx([3.0, 2.0, 5.0])
+
+
+def test_the_flight_estimate_said_before_flying_is_the_mission_s_length():
+    """``fly`` says up front how long the flight is and bounds its wait by it: the estimate
+    (straight legs between the stored positions, loiter circles, the way home) is within 1 %
+    of the planned flight for waypoint missions."""
+    from dtsp_mission.sim.fly import estimated_flight_m
+    for mission in (make_mission(8, 4, 80.0, span_m=1200.0, airspeed_m_s=20.0),
+                    make_mission(40, 7, 80.0, airspeed_m_s=20.0, design="geometry")):
+        estimate = estimated_flight_m(mission.for_vehicle(), 80.0)
+        assert abs(estimate / mission.summary["flight_length_m"] - 1.0) < 0.01
