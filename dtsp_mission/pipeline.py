@@ -22,8 +22,8 @@ from .dubins.path import check_radius
 from .errors import InputError, MissionTooLarge
 from .frame import LocalFrame, mission_centre
 from .mission import Mission, MissionSettings, build_mission
-from .mission.build import (check_altitude_floor, check_storage, targets_beyond,
-                            with_turn_margin)
+from .mission.build import check_storage, targets_beyond, with_turn_margin
+from .mission.settings import check_altitude_floor
 from .mission.sorties import Sortie, split_into_sorties
 from .planning import TilingUnavailable, get_planner
 from .planning.lower_bounds import LowerBound, lower_bound

@@ -1,6 +1,7 @@
 """From tour to mission: the flight path, its waypoints, and the list of mission items."""
 
-from .build import DEFAULT_MAX_ITEMS, MissionSettings, build_mission
+from .build import build_mission
+from .settings import DEFAULT_MAX_ITEMS, MissionSettings
 from .guidance import DesignTuning
 from ..autopilot.commands import AUTOPILOTS, Autopilot, Command, Frame
 from .model import (FlightPath, Home, Mission, MissionItem, VehicleMission,

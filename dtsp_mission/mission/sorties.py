@@ -18,7 +18,8 @@ from ..errors import InputError, MissionTooLarge
 from ..frame import LocalFrame
 from ..targets import GeoTargets
 from ..tour import Tour, tour_through_poses
-from .build import MissionSettings, build_mission, targets_beyond, with_turn_margin
+from .build import build_mission, targets_beyond, with_turn_margin
+from .settings import MissionSettings
 from .model import Mission
 
 #: Most sorties tried before giving up.

@@ -88,6 +88,13 @@ class GeoTargets:
     def with_area(self, area_deg: np.ndarray | None) -> "GeoTargets":
         return replace(self, area_deg=area_deg)
 
+    def label(self, index: int) -> str:
+        """How a message names target ``index`` (input order): the row of its file ("line
+        7"), else its number; with its name where it has one."""
+        name = self.names[index] if self.names else ""
+        row = target_name(self.rows, index)
+        return f"{row} ({name})" if name else row
+
     def subset(self, indices: np.ndarray) -> "GeoTargets":
         """The targets at ``indices`` (in that order), with their names, altitudes and actions."""
         keep = np.asarray(indices, dtype=np.int64)
