@@ -175,6 +175,14 @@ def parameters_with(parameters: VehicleParameters, airspeed_m_s: float | None = 
     return parameters
 
 
+def launch_heading_rad(items: list[LocalItem], first: int) -> float:
+    """The heading an aircraft stands at home with before a mission: towards the first item
+    from ``first`` on with a position more than 1 m from home (0, east, if none)."""
+    ahead = next((i for i in items[first:] if not math.isnan(i.x_m)
+                  and math.hypot(i.x_m, i.y_m) > 1.0), None)
+    return math.atan2(ahead.y_m, ahead.x_m) if ahead is not None else 0.0
+
+
 def local_items(wire: list, frame, home_amsl_m: float) -> list[LocalItem]:
     """Mission items (MISSION_ITEM_INT form, :class:`~dtsp_mission.autopilot.storage.WireItem`)
     in the local ``frame`` (a :class:`~dtsp_mission.frame.LocalFrame` at home), altitudes above

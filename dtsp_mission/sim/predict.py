@@ -13,8 +13,8 @@ from dataclasses import dataclass
 import numpy as np
 
 from ..autopilot import Command, stored_item
-from ..autopilot.navigation import (CALM, FLIGHT_LIMIT_S, MODEL_STEP_S, Airframe, LocalItem, MissionFlight, Wind,
-                                    local_items)
+from ..autopilot.navigation import (CALM, FLIGHT_LIMIT_S, MODEL_STEP_S, Airframe, LocalItem,
+                                    MissionFlight, Wind, launch_heading_rad, local_items)
 from ..frame import LocalFrame
 from ..mission import VehicleMission
 from ..autopilot.wire import first_mission_seq, to_wire
@@ -46,9 +46,7 @@ def predict_flight(mission: VehicleMission, airframe: Airframe, dt_s: float = MO
         items.append(LocalItem(len(items), Command.NAV_RETURN_TO_LAUNCH, math.nan, math.nan,
                                items[-1].alt_m, (0.0, 0.0, 0.0, 0.0)))
     first = first_mission_seq(mission.autopilot)
-    ahead = next((i for i in items[first:] if not math.isnan(i.x_m)
-                  and math.hypot(i.x_m, i.y_m) > 1.0), None)
-    heading = math.atan2(ahead.y_m, ahead.x_m) if ahead is not None else 0.0
+    heading = launch_heading_rad(items, first)
     flight = MissionFlight(items, airframe, heading, first, wind)
     last = max((i.seq for i in items if i.command in _FLOWN), default=first)
     head = np.zeros((1, 4))

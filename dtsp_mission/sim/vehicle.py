@@ -19,7 +19,6 @@ MAV_CMD_MISSION_START, MISSION_CURRENT / MISSION_ITEM_REACHED while flying, and 
 
 from __future__ import annotations
 
-import math
 import threading
 import time
 from dataclasses import dataclass, field
@@ -36,7 +35,7 @@ from pymavlink.dialects.v20.common import (MAVLINK_MSG_ID_HOME_POSITION, MAV_CMD
                                            MAV_TYPE_FIXED_WING)
 
 from ..autopilot.navigation import (CALM, MODEL_STEP_S, Airframe, LocalItem, MissionFlight, Wind,
-                                    local_items)
+                                    launch_heading_rad, local_items)
 from ..autopilot.parameters import ARDUPLANE_DEFAULTS, NAMES, VehicleParameters, parameter_name
 from ..autopilot.storage import MissionStore, stored_item
 from ..frame import LocalFrame
@@ -373,9 +372,7 @@ class SimulatedVehicle:
             items = self.local_items()
             if len(items) <= first or (self.flight is not None and not self.finished.is_set()):
                 return False
-            ahead = next((i for i in items[first:] if not math.isnan(i.x_m)
-                          and math.hypot(i.x_m, i.y_m) > 1.0), None)
-            heading = math.atan2(ahead.y_m, ahead.x_m) if ahead is not None else 0.0
+            heading = launch_heading_rad(items, first)
             self.log = FlightLog()
             self.finished.clear()
             self._completed = 0

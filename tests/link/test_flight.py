@@ -3,13 +3,12 @@ completion, and miss distances measured against the exact planned path."""
 
 from __future__ import annotations
 
-import math
-
 import numpy as np
 import pytest
 
 from conftest import make_mission
-from dtsp_mission.autopilot.navigation import G, Airframe, MissionFlight, closest_approach_m
+from dtsp_mission.autopilot.navigation import (G, Airframe, MissionFlight, closest_approach_m,
+                                              launch_heading_rad)
 from dtsp_mission.sim.vehicle import SimulatedVehicle, VehicleSettings
 from dtsp_mission.autopilot.wire import first_mission_seq, to_wire
 
@@ -21,9 +20,8 @@ def fly_offline(mission, airframe: Airframe):
         items = vehicle.local_items()
     finally:
         vehicle._transport.close()
-    ahead = next(i for i in items[first_mission_seq(mission.autopilot) + 1:] if i.command == 16)
-    flight = MissionFlight(items, airframe, math.atan2(ahead.y_m, ahead.x_m),
-                           first_mission_seq(mission.autopilot))
+    first = first_mission_seq(mission.autopilot)
+    flight = MissionFlight(items, airframe, launch_heading_rad(items, first), first)
     track, banks = [(0.0, 0.0, 0.0)], []
     while not flight.finished and flight.state.time_s < 4000:
         flight.step(0.05)
