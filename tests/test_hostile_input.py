@@ -204,7 +204,7 @@ def test_a_negative_relative_altitude_in_a_plan_is_refused(tmp_path):
 
 
 @pytest.mark.parametrize("option,value,words", [
-    ("--max-items", 3, ["for the target(s)"]),
+    ("--max-items", 3, ["a sortie needs at least 4 items", "allow more"]),
     ("--endurance", 0.01, ["--endurance"]),
 ])
 def test_capacity_messages_say_what_is_needed(tmp_path, option, value, words):

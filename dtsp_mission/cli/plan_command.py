@@ -419,7 +419,7 @@ def _report_mission(mission) -> None:
                    f"{misses.max():.1f} m in the flight model, {_wind_text(summary['design_wind'])}")
         say(f"  predicted flight {summary['predicted_flight_m'] / 1e3:,.2f} km against "
                    f"{summary['planned_flight_m'] / 1e3:,.2f} km of exact path (take-off to the "
-                   "last target)")
+                   "last target, and its loiter if it has one)")
     else:
         say(f"mission ({flavour}): {summary['items']} items, {summary['vehicle_slots']} "
                    f"vehicle slots; waypoints within {mission.tolerance_m:.2f} m of the exact path")

@@ -121,9 +121,16 @@ def split_into_sorties(tour: Tour, frame: LocalFrame, targets: GeoTargets,
         except (MissionTooLarge, _TooLong) as error:
             last_error = error
     max_items = settings.checked(tour.rho_m).max_items
-    raise InputError(f"even {min(MAX_SORTIES, n)} sorties do not fit the vehicle "
-                     f"({max_items} items"
-                     f"{f', {endurance_s / 60:g} min of endurance' if endurance_s else ''}): {last_error}")
+    limits = (f"{max_items} items"
+              f"{f', {endurance_s / 60:g} min of endurance' if endurance_s else ''}")
+    if isinstance(last_error, MissionTooLarge):
+        # Splitting further is what was just tried: only more room helps.
+        raise InputError(f"even {min(MAX_SORTIES, n)} sorties do not fit the vehicle ({limits}): "
+                         f"a sortie needs at least {last_error.needed} items but the vehicle holds "
+                         f"{last_error.capacity} (--max-items); allow more if it has the space "
+                         "(ArduPilot with the mission on SD card holds about 4,300)")
+    raise InputError(f"even {min(MAX_SORTIES, n)} sorties do not fit the vehicle ({limits}): "
+                     f"{last_error}")
 
 
 def _widened(mission, chosen, tour, targets, settings, endurance_s, replan):
