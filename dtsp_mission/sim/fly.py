@@ -55,9 +55,8 @@ def targets_from(geodetic) -> Targets:
     count = len(geodetic)
     altitudes = (np.full(count, np.nan) if geodetic.altitudes_m is None
                  else np.asarray(geodetic.altitudes_m, dtype=float))
-    names = tuple(target_name(geodetic.names, i) for i in range(count))
     return Targets(np.asarray(geodetic.latitudes_deg), np.asarray(geodetic.longitudes_deg),
-                   altitudes, tuple(names))
+                   altitudes, tuple(target_name(geodetic.names, i) for i in range(count)))
 
 
 #: A simulated vehicle that sends no telemetry for this long has stopped (s, wall clock).
@@ -66,22 +65,22 @@ SILENCE_S = 20.0
 FAR_FROM_MISSION_M = 5_000.0
 
 
-def mission_places_m(mission: VehicleMission) -> tuple[np.ndarray, list]:
-    """The mission's home (row 0) and its positioned items, in the local frame around home;
-    and those items."""
+def mission_places_m(mission: VehicleMission) -> tuple[LocalFrame, np.ndarray, list]:
+    """The local frame around the mission's home; in it, home (row 0) and the positioned
+    items; and those items."""
     frame = LocalFrame(mission.home.latitude_deg, mission.home.longitude_deg)
     positioned = [i for i in mission.items if i.has_position]
     places = np.vstack([np.zeros((1, 2))] + ([frame.to_local([i.latitude_deg for i in positioned],
                                                              [i.longitude_deg for i in positioned])]
                                              if positioned else []))
-    return places, positioned
+    return frame, places, positioned
 
 
 def estimated_flight_m(mission: VehicleMission, loiter_radius_m: float) -> float:
     """A quick estimate of the flight's length for a progress message (not a prediction):
     straight legs from home through the positioned items, the loiter circles' turns
     (``loiter_radius_m`` where an item gives none), and the way back home after a return."""
-    places, positioned = mission_places_m(mission)
+    _, places, positioned = mission_places_m(mission)
     length = float(np.hypot(*np.diff(places, axis=0).T).sum())
     for item in positioned:
         if item.command == Command.NAV_LOITER_TURNS:
@@ -95,8 +94,7 @@ def estimated_flight_m(mission: VehicleMission, loiter_radius_m: float) -> float
 def check_targets_near(mission: VehicleMission, targets: Targets, where: str) -> None:
     """:class:`InputError` when a target is more than :data:`FAR_FROM_MISSION_M` from every
     position of the mission (its home and items): they are not this mission's targets."""
-    places, _ = mission_places_m(mission)
-    frame = LocalFrame(mission.home.latitude_deg, mission.home.longitude_deg)
+    frame, places, _ = mission_places_m(mission)
     points = frame.to_local(targets.latitudes_deg, targets.longitudes_deg)
     gaps = np.array([np.hypot(*(places - point).T).min() for point in points])
     if len(gaps) and gaps.max() > FAR_FROM_MISSION_M:
@@ -205,7 +203,7 @@ def _watch(vehicle: SimulatedVehicle, connection: str, mission: VehicleMission, 
         budget = timeout_s or (60.0 + 2 * max(flight_s, 7200.0) / max(speedup, 1.0)
                                + len(mission.items))
         deadline = time.monotonic() + budget
-        last_heartbeat = last_heard = time.monotonic()
+        last_heartbeat, last_heard = 0.0, time.monotonic()
         while highest < last_seq:
             now = time.monotonic()
             if now > deadline:
