@@ -28,7 +28,7 @@ from dtsp_mission.errors import InputError
 from dtsp_mission.files import write_atomic
 from dtsp_mission.frame import LocalFrame
 from dtsp_mission.mission import MissionSettings, build_mission
-from dtsp_mission.mission.build import targets_beyond, with_turn_margin
+from dtsp_mission.mission.widening import targets_beyond, with_turn_margin
 from dtsp_mission.sim.predict import predict_flight
 from dtsp_mission.targets import read_targets
 from dtsp_mission.targets.model import local_targets

@@ -18,7 +18,7 @@ class InputError(DtspError, ValueError):
 
 
 class MissionTooLarge(InputError):
-    """The mission needs more items than the vehicle holds (``--max-items``): ``needed``
+    """The mission needs more items than the vehicle holds (``max_items``): ``needed``
     items (at least) against ``capacity``."""
 
     def __init__(self, message: str, needed: int = 0, capacity: int = 0) -> None:

@@ -22,7 +22,8 @@ from .dubins.path import check_radius
 from .errors import InputError, MissionTooLarge
 from .frame import LocalFrame, mission_centre
 from .mission import Mission, MissionSettings, build_mission
-from .mission.build import check_storage, targets_beyond, with_turn_margin
+from .mission.build import check_storage
+from .mission.widening import targets_beyond, with_turn_margin
 from .mission.settings import check_altitude_floor
 from .mission.sorties import Sortie, split_into_sorties
 from .planning import TilingUnavailable, get_planner
@@ -108,7 +109,7 @@ def place(targets: GeoTargets | Targets,
     local targets without ``origin``); :class:`InputError` if they do not fit one frame."""
     if isinstance(targets, GeoTargets):
         if origin is not None:
-            raise InputError("an origin is for targets in local x/y metres; these are in lat/lon")
+            raise InputError("an `origin` is for targets in local x/y metres; these are in lat/lon")
         frame = LocalFrame(*mission_centre(targets.latitudes_deg, targets.longitudes_deg))
         return targets.in_frame(frame), targets, frame
     if origin is None:
@@ -158,6 +159,37 @@ def _bound(positions: np.ndarray, rho_m: float, area_m: np.ndarray | None) -> Lo
 MAX_PLAN_RADIUS_M = 20_000.0
 
 
+def check_request(request: PlanRequest) -> None:
+    """:class:`InputError` for anything in ``request`` that cannot be planned, before any
+    planning: the radius, targets that do not fit one frame or are fewer than 2, a mission
+    for targets not on the earth, the mission's settings, the altitude floor, an endurance
+    without an airspeed.  :func:`run_plan` makes exactly these checks first."""
+    _checked(request)
+
+
+def _checked(request: PlanRequest) -> tuple[Targets, GeoTargets | None, LocalFrame | None]:
+    """:func:`check_request`, and the targets placed (:func:`place`)."""
+    check_radius(request.rho_m)
+    if request.rho_m > MAX_PLAN_RADIUS_M:
+        raise InputError(f"a turn radius of {request.rho_m:g} m is beyond reason for a mission "
+                         f"(at most {MAX_PLAN_RADIUS_M:,.0f} m: the turn alone would span more than "
+                         "the mission frame holds); is it in metres?")
+    settings = request.settings
+    if request.endurance_s is not None and (settings is None or settings.airspeed_m_s is None):
+        raise InputError("`endurance_s` needs `airspeed_m_s`: the flight time follows from it")
+    local, geodetic, frame = place(request.targets, request.origin)
+    if len(local) < 2:
+        raise InputError(f"the targets hold {len(local)} target(s) after merging duplicates; a "
+                         "tour needs at least 2 (for one point, fly a single waypoint)")
+    if settings is not None and frame is None:
+        raise InputError("a mission needs targets in degrees: these are local x/y metres, so "
+                         "give `origin` LAT,LON (or ask for the tour only)")
+    if settings is not None:
+        settings.checked(request.rho_m)
+        check_altitude_floor(geodetic, settings)
+    return local, geodetic, frame
+
+
 def run_plan(request: PlanRequest,
              progress: Callable[[float], None] | None = None,
              design_progress: Callable[[float], None] | None = None) -> PlanResult:
@@ -168,21 +200,7 @@ def run_plan(request: PlanRequest,
     vehicle's storage; what was decided on the user's behalf is in ``notes``.  Bad input is an
     :class:`~dtsp_mission.errors.InputError` before any planning.
     """
-    check_radius(request.rho_m)
-    if request.rho_m > MAX_PLAN_RADIUS_M:
-        raise InputError(f"a turn radius of {request.rho_m:g} m is beyond reason for a mission "
-                         f"(at most {MAX_PLAN_RADIUS_M:,.0f} m: the turn alone would span more than "
-                         "the mission frame holds); is it in metres?")
-    local, geodetic, frame = place(request.targets, request.origin)
-    if len(local) < 2:
-        raise InputError(f"{len(local)} target(s) after merging duplicates; a tour needs at "
-                         "least 2 (for one point, fly a single waypoint)")
-    if request.settings is not None and frame is None:
-        raise InputError("a mission needs targets in degrees: these are local x/y metres, so "
-                         "give their origin (lat, lon)")
-    if request.settings is not None:
-        request.settings.checked(request.rho_m)
-        check_altitude_floor(geodetic, request.settings)
+    local, geodetic, frame = _checked(request)
     notes: list[str] = []
     if local.merged_duplicates:
         notes.append(f"{local.merged_duplicates} duplicate targets merged ({len(local)} remain)")
@@ -225,9 +243,9 @@ def _design_mission(request: PlanRequest, result: PlanResult,
         if request.too_large == "raise":
             raise
         _split(request, result, f"as one mission it needs {error.needed} items (at least) but "
-                                f"the vehicle holds {error.capacity} (--max-items)")
+                                f"the vehicle holds {error.capacity} (`max_items`)")
         return
-    if "predicted_miss_m" in mission.summary:
+    if mission.guidance is not None:
         replan = lambda rho: plan_tour_in(result.local.positions_m, rho, request.algorithm,  # noqa: E731
                                           request.parameters, request.fallback)
         widened = with_turn_margin(mission, replan, geodetic, settings,
@@ -245,7 +263,7 @@ def _design_mission(request: PlanRequest, result: PlanResult,
     flight_s = mission.summary.get("flight_time_s", 0.0)
     if endurance_s is not None and flight_s > endurance_s:
         _split(request, result, f"the flight takes {flight_s / 60:.1f} min, more than the "
-                                f"endurance of {endurance_s / 60:g} min (--endurance)")
+                                f"endurance of {endurance_s / 60:g} min (`endurance_s`)")
 
 
 def _split(request: PlanRequest, result: PlanResult, reason: str) -> None:

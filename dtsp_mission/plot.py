@@ -27,7 +27,7 @@ def require_matplotlib() -> None:
     try:
         import matplotlib  # noqa: F401
     except ImportError:
-        raise InputError("--plot needs matplotlib: pip install 'dtsp-mission[plot]'") from None
+        raise InputError("drawing a plot needs matplotlib: pip install 'dtsp-mission[plot]'") from None
 
 
 #: Picture formats by file extension (matplotlib's writers).

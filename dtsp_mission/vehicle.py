@@ -1,29 +1,12 @@
-"""The aircraft as the planner sees it: turn radius, airspeed, autopilot."""
+"""Units of the aircraft's world: gravity, compass bearings and local headings.  (What radius
+the aircraft turns at a bank is :meth:`dtsp_mission.autopilot.navigation.Airframe.turn_radius_m`.)"""
 
 from __future__ import annotations
 
 import math
 
-from .errors import InputError
-
 #: Standard gravity, m/s^2.
 STANDARD_GRAVITY_M_S2 = 9.80665
-
-
-def turn_radius_m(airspeed_m_s: float, max_bank_deg: float) -> float:
-    """Radius of a coordinated level turn, ``v^2 / (g tan(bank))``: the smallest radius the
-    aircraft flies at that airspeed without banking more than ``max_bank_deg``."""
-    if not (math.isfinite(airspeed_m_s) and airspeed_m_s > 0):
-        raise InputError(f"airspeed must be a number above 0 m/s, got {airspeed_m_s!r}")
-    if not (math.isfinite(max_bank_deg) and 0 < max_bank_deg < 90):
-        raise InputError(f"maximum bank must be between 0 and 90 degrees (exclusive), "
-                         f"got {max_bank_deg!r}")
-    return airspeed_m_s ** 2 / (STANDARD_GRAVITY_M_S2 * math.tan(math.radians(max_bank_deg)))
-
-
-def bank_for_radius_deg(airspeed_m_s: float, rho_m: float) -> float:
-    """Bank angle of a coordinated level turn of radius ``rho_m`` at ``airspeed_m_s``."""
-    return math.degrees(math.atan(airspeed_m_s ** 2 / (STANDARD_GRAVITY_M_S2 * rho_m)))
 
 
 def bearing_to_heading_rad(bearing_deg: float) -> float:

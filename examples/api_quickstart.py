@@ -55,7 +55,7 @@ def main() -> None:
         print("wrote", written)
 
     # Upload to a vehicle and read back what it holds.
-    vehicle = SimulatedVehicle(VehicleSettings(mission.home, mission.autopilot, Airframe(20.0, 70.0)))
+    vehicle = SimulatedVehicle(VehicleSettings(mission.home, mission.autopilot, Airframe.turning_at(70.0, 20.0)))
     with vehicle:
         connection = f"udpout:127.0.0.1:{vehicle.port}"
         report = upload_mission(mission.for_vehicle(), connection, via="pymavlink")

@@ -25,7 +25,7 @@ from dtsp_mission.export import exporter_for
 from dtsp_mission.files import write_atomic
 from dtsp_mission.mission import MissionSettings
 from dtsp_mission.targets import read_targets
-from dtsp_mission.vehicle import turn_radius_m
+from dtsp_mission.autopilot.navigation import Airframe
 
 HERE = Path(__file__).resolve().parent
 
@@ -61,7 +61,8 @@ def main() -> None:
     _, local = local_frame_for(site)
     rows = []
     for aircraft, members in zip(FLEET, sectors(local.positions_m, len(FLEET))):
-        rho = turn_radius_m(aircraft.airspeed_m_s, aircraft.max_bank_deg)
+        # the radius the aircraft turns at its largest bank (the flight model's answer)
+        rho = Airframe(aircraft.airspeed_m_s, aircraft.max_bank_deg).tightest_turn_m
         mission = plan_mission(site.subset(members), rho, MissionSettings(
             autopilot=aircraft.autopilot, altitude_m=120.0, airspeed_m_s=aircraft.airspeed_m_s,
             max_items=aircraft.max_items))

@@ -2,10 +2,13 @@
 overflight altitude) planned for an aircraft whose limit is 72 m turns, checked in the simulated
 aircraft before anyone flies it.
 
-Follows docs/user-guide.md: plan with rho about 10 % above the aircraft's tightest turn (80 m
-for 72 m), write the mission for QGroundControl (with a geofence, if the ``dtsp-mission-fence``
-plugin is installed) and for Google Earth (``dtsp-mission-kml``), then ``--fly`` uploads it to
-the simulator and reports how close the aircraft passed each point.
+Plans with rho about 10 % above the aircraft's tightest turn (80 m for 72 m) and the geometric
+design (the waypoint polyline of the exact path, with room for 4,000 items: seconds, where the
+guidance design of ``dtsp-mission plan`` takes a minute or two), writes the mission for
+QGroundControl (with a geofence, if the ``dtsp-mission-fence`` plugin is installed) and for
+Google Earth (``dtsp-mission-kml``), then ``--fly`` uploads it to the simulator and reports how
+close the aircraft passed each point: ArduPlane's L1 guidance cuts the polyline's corners, up
+to 30-40 m on this site (docs/mission-items.md) -- what ``--design guidance`` is for.
 
 Run: python examples/site_inspection.py [--out DIR] [--fly] [--speedup 50]
 """
@@ -55,8 +58,7 @@ def main() -> None:
     if args.fly:
         vehicle_mission = mission.for_vehicle()
         check = fly_mission(vehicle_mission, targets_in(vehicle_mission, mission.target_names),
-                            Airframe(AIRSPEED_M_S, AIRCRAFT_MIN_TURN_M, l1_period_s=5.0,
-                                     roll_natural_rad_s=6.0, roll_damping=0.8),
+                            Airframe.turning_at(AIRCRAFT_MIN_TURN_M, AIRSPEED_M_S),
                             speedup=args.speedup, max_items=4000)     # SD storage, as planned
         worst = int(np.argmax(check.miss_m))
         print(f"flown: completed {check.completed}, {check.items_reached}/{check.items} items, "

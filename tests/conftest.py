@@ -101,7 +101,7 @@ def start_vehicle():
     started = []
 
     def start(mission, **settings):
-        settings.setdefault("airframe", Airframe(20.0, 80.0))
+        settings.setdefault("airframe", Airframe.turning_at(80.0, 20.0))
         settings.setdefault("autopilot", mission.autopilot)
         vehicle = SimulatedVehicle(VehicleSettings(mission.home, **settings))
         started.append(vehicle.start())

@@ -88,3 +88,31 @@ def test_no_command_module_imports_another():
             if isinstance(node, ast.ImportFrom):
                 imported = (node.module or "").split(".")[-1]
                 assert imported not in commands, f"{path.name} imports {node.module}"
+
+
+def test_the_library_speaks_in_its_own_terms_and_the_cli_in_options():
+    """No message of the library names a command-line option (an API caller never passes
+    one); it names its parameters in backticks, and the CLI prints the option that sets
+    each (every such name in the library is mapped)."""
+    import ast
+    import re
+    from pathlib import Path
+    from dtsp_mission.cli.console import OPTIONS, in_cli_terms
+    package = Path(__file__).resolve().parents[1] / "dtsp_mission"
+    named, flags = set(), []
+    for path in package.rglob("*.py"):
+        if "cli" in path.relative_to(package).parts or path.parent.name == "bench":
+            continue
+        tree = ast.parse(path.read_text())
+        docstrings = {id(node.body[0].value) for node in ast.walk(tree)
+                      if isinstance(node, (ast.Module, ast.ClassDef, ast.FunctionDef))
+                      and node.body and isinstance(node.body[0], ast.Expr)}
+        for node in ast.walk(tree):
+            if isinstance(node, ast.Constant) and isinstance(node.value, str) \
+                    and id(node) not in docstrings:
+                flags += [f"{path.name}: {m}" for m in re.findall(r"(?<![\w-])--[a-z][a-z-]+", node.value)]
+                named |= set(re.findall(r"`([a-z_]+(?:=False)?)`", node.value))
+    assert not flags, flags
+    assert named and named <= set(OPTIONS), named - set(OPTIONS)
+    assert in_cli_terms("lower `max_items` and plan again (`verify=False`)") == \
+        "lower --max-items and plan again (--no-verify)"

@@ -59,7 +59,9 @@ def test_site_inspection_plans_writes_and_flies_every_point(tmp_path):
     flown = next(line for line in out.splitlines() if line.startswith("flown:"))
     assert "completed True" in flown
     worst = float(flown.split("worst ")[1].split(" m")[0])
-    assert worst < 20.0          # see docs/mavlink.md: a reacting guidance law, 10 % margin
+    # The geometric design cut at the corners by ArduPlane's L1 guidance: docs/mission-items.md
+    # measures this site's polyline at worst 36.6 m (the guidance design: 5.6 m).
+    assert worst < 40.0
 
 
 def test_algorithm_figures_are_drawn_from_the_code(tmp_path):

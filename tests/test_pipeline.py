@@ -8,7 +8,7 @@ import pytest
 
 from dtsp_mission.errors import InputError, MissionTooLarge
 from dtsp_mission.mission import MissionSettings
-from dtsp_mission.mission.build import targets_beyond
+from dtsp_mission.mission.widening import targets_beyond
 from dtsp_mission.pipeline import PlanRequest, run_plan
 from dtsp_mission.targets.model import local_targets
 

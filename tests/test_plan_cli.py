@@ -60,8 +60,8 @@ def test_rbta_falls_back_when_too_few_targets(tmp_path):
 BAD_INPUTS = [
     ("targets.csv", "", [], "the file is empty"),
     ("targets.csv", "x,y\n", [], "no targets below the header"),
-    ("targets.csv", "x,y\n10,20\n", [], "holds 1 target(s)"),
-    ("targets.csv", "x,y\n10,20\n10,20\n", [], "holds 1 target(s)"),
+    ("targets.csv", "x,y\n10,20\n", [], "hold 1 target(s) after merging duplicates"),
+    ("targets.csv", "x,y\n10,20\n10,20\n", [], "hold 1 target(s) after merging duplicates"),
     ("targets.csv", "lat,height\n1,3\n", [], "the header must name either columns lat and lon"),
     ("targets.csv", "easting,northing\n1,2\n", [],
      "the header must name either columns lat and lon (degrees) or x and y (metres)"),

@@ -111,7 +111,8 @@ def test_random_targets_in_a_polygon_are_seeded(tmp_path):
     assert run(*common, "--seed", "4", "-o", second).returncode == 0
     result = run(*common, "--seed", "5", "-o", other)
     assert result.returncode == 0, result.stderr
-    assert "rho 70.6 m from airspeed 20 m/s and 30 deg bank" in result.stdout
+    # the radius the flight model's aircraft turns at that bank: 20^2 / (0.73 g tan 30 deg)
+    assert "rho 96.8 m: the aircraft's turn at 20 m/s and 30 deg bank" in result.stdout
     assert first.read_text() == second.read_text() != other.read_text()
     assert "\t21\t" in first.read_text().splitlines()[-1]      # PX4 default: a landing
 
@@ -187,8 +188,11 @@ def test_sanity_checks_refuse_or_warn_with_a_clear_message(tmp_path):
     targets = tmp_path / "t.csv"
     targets.write_text("lat,lon\n46.80,6.94\n46.81,6.95\n46.805,6.955\n")
     steep = run(targets, "--radius", 5, "--airspeed", 22)
-    assert steep.returncode == 2 and "needs 84 deg of bank, beyond the aircraft's roll limit of 65 deg" \
-        in steep.stderr and "no tighter than 23 m" in steep.stderr
+    # the smallest radius named is the one the flight model flies: 22^2 / (0.73 g tan 65 deg)
+    assert steep.returncode == 2 and "cannot turn at 5 m: at 22 m/s with a roll limit of 65 deg" \
+        in steep.stderr and "no tighter than 32 m" in steep.stderr
+    assert run(targets, "--radius", 31, "--airspeed", 22, "-o", tmp_path / "t.json").returncode == 2
+    assert run(targets, "--radius", 32, "--airspeed", 22, "-o", tmp_path / "t.json").returncode == 0
     high = run(targets, "--radius", 80, "--alt", 50000)
     assert high.returncode == 2 and "altitude 50000 m above home is beyond 10000 m" in high.stderr
     assert "needs --airspeed" in run(targets, "--radius", 80, "--endurance", 10).stderr

@@ -53,11 +53,11 @@ S_XTRACK_I, S_LAST_WAYPOINT_UPDATE, S_LAST_NU = 23, 24, 25   # L1 integrator, it
 STATE_SIZE = 26
 
 # -- the airframe vector -----------------------------------------------------------------------
-(A_AIRSPEED, A_MIN_RADIUS, A_L1_PERIOD, A_WP_RADIUS, A_ROLL_W, A_ROLL_Z, A_L1_DAMPING,
+(A_AIRSPEED, A_L1_PERIOD, A_WP_RADIUS, A_ROLL_W, A_ROLL_Z, A_L1_DAMPING,
  A_ROLL_LIMIT, A_LOITER_RADIUS, A_CLIMB, A_SINK, A_ALT_TC, A_TKO_ACCEL, A_TKO_CLIMB,
  A_TURN_EFFICIENCY, A_NAV_HZ, A_WIND_X, A_WIND_Y, A_WIND_FULL_ALT, A_TKO_PITCH,
- A_XTRACK_I_GAIN) = range(21)
-AIRFRAME_SIZE = 21
+ A_XTRACK_I_GAIN) = range(20)
+AIRFRAME_SIZE = 20
 
 LOITER_EXIT_HEADING_RAD = math.radians(10.0)
 TWO_PI = 2.0 * math.pi
@@ -120,10 +120,10 @@ def l1_distance(af, speed):
 
 
 @numba.njit(inline="always", **_JIT)
-def _max_bank(af, airspeed):
-    if not math.isnan(af[A_ROLL_LIMIT]):
-        return math.radians(af[A_ROLL_LIMIT])
-    return math.atan(airspeed * airspeed / (G * af[A_MIN_RADIUS]))
+def turn_rate_rad_s(airspeed, bank_rad, efficiency):
+    """How fast the aircraft turns at ``bank_rad``: ``efficiency`` times the coordinated-turn
+    rate ``g tan(bank) / airspeed`` (its radius through the air: airspeed over this)."""
+    return efficiency * G * math.tan(bank_rad) / airspeed
 
 
 @numba.njit(inline="always", **_JIT)
@@ -223,13 +223,13 @@ def _fly(st, af, dt, lateral_accel, climb_rate, ground_factor):
     response, the aircraft turns at its bank (exact arc of the step through the air) and
     drifts with the wind."""
     airspeed = st[S_AIRSPEED]
-    limit = _max_bank(af, airspeed)
+    limit = math.radians(af[A_ROLL_LIMIT])
     command = _clip(math.atan(lateral_accel / G), -limit, limit)
     w, z = af[A_ROLL_W], af[A_ROLL_Z]
     st[S_BANK_RATE] += (w * w * (command - st[S_BANK]) - 2 * z * w * st[S_BANK_RATE]) * dt
     st[S_BANK] = _clip(st[S_BANK] + st[S_BANK_RATE] * dt, -limit, limit)
     air = airspeed * ground_factor
-    turn_rate = af[A_TURN_EFFICIENCY] * G * math.tan(st[S_BANK]) / airspeed
+    turn_rate = turn_rate_rad_s(airspeed, st[S_BANK], af[A_TURN_EFFICIENCY])
     heading0 = st[S_HEADING]
     heading = heading0 + turn_rate * dt
     if abs(turn_rate) > 1e-12:    # exact arc of the step

@@ -5,8 +5,8 @@ line), LOITER_TURNS with fractional turns and the tangent exit, take-off and a T
 
 Pure computation, no network: :class:`MissionFlight` takes the mission's items in the local
 frame (metres east/north of home, altitude above home) and advances by :meth:`step`.  The bank
-angle is limited to the roll limit (``ROLL_LIMIT_DEG``; without one, to ``atan(v^2 / (g
-rho))`` for the airframe's minimum turn radius) and follows its command as a damped
+angle is limited to the roll limit (``ROLL_LIMIT_DEG``), the aircraft turns at that bank with
+the radius :meth:`Airframe.turn_radius_m` says, and the bank follows its command as a damped
 second-order response, whose frequency and damping were fitted to ArduPlane SITL's roll
 (``tests/data/arduplane-sitl``).  Its parameters come from :class:`Airframe`, usually made from
 the vehicle's parameters (:meth:`Airframe.from_parameters`).
@@ -25,11 +25,6 @@ from .commands import Command, Frame
 from .parameters import ARDUPLANE_DEFAULTS, VehicleParameters
 
 G = K.G
-#: ArduPlane defaults: NAVL1_DAMPING, WP_RADIUS (m).
-L1_DAMPING = 0.75
-WP_RADIUS_M = 90.0
-MAX_CLIMB_RATE_M_S = 5.0
-MAX_SINK_RATE_M_S = 5.0
 TAKEOFF_PITCH_DEG = 15.0
 #: The roll response of ArduPlane SITL's stock plane to a step in demanded roll (a damped
 #: second-order lag fitted to the recorded corners: peak after 0.9 s, 9 % overshoot).
@@ -59,65 +54,73 @@ NAV_LAST = 95
 
 @dataclass(frozen=True)
 class Airframe:
-    """The simulated aircraft and its autopilot tuning."""
+    """The simulated aircraft and its autopilot tuning.  The defaults are the aircraft the
+    product ships: ArduPlane SITL's stock plane with a stock ArduPlane's parameters
+    (``Airframe() == Airframe.from_parameters()``); :meth:`turning_at` gives the same aircraft
+    with a roll limit that turns no tighter than a radius."""
 
-    airspeed_m_s: float = 20.0
-    min_turn_radius_m: float = 80.0
-    l1_period_s: float = 12.0          # ArduPlane's NAVL1_PERIOD
-    wp_radius_m: float = WP_RADIUS_M
+    airspeed_m_s: float = ARDUPLANE_DEFAULTS.AIRSPEED_CRUISE
+    roll_limit_deg: float = ARDUPLANE_DEFAULTS.ROLL_LIMIT_DEG
+    l1_period_s: float = ARDUPLANE_DEFAULTS.NAVL1_PERIOD
+    wp_radius_m: float = ARDUPLANE_DEFAULTS.WP_RADIUS
     roll_natural_rad_s: float = ROLL_NATURAL_RAD_S
     roll_damping: float = ROLL_DAMPING
-    l1_damping: float = L1_DAMPING
-    roll_limit_deg: float | None = None     # None: the bank that turns at min_turn_radius_m
-    loiter_radius_m: float = 80.0
-    max_climb_m_s: float = MAX_CLIMB_RATE_M_S
-    max_sink_m_s: float = MAX_SINK_RATE_M_S
-    altitude_time_constant_s: float = 1.0
+    l1_damping: float = ARDUPLANE_DEFAULTS.NAVL1_DAMPING
+    loiter_radius_m: float = ARDUPLANE_DEFAULTS.WP_LOITER_RAD
+    max_climb_m_s: float = ARDUPLANE_DEFAULTS.TECS_CLMB_MAX
+    max_sink_m_s: float = ARDUPLANE_DEFAULTS.TECS_SINK_MAX
+    altitude_time_constant_s: float = ARDUPLANE_DEFAULTS.TECS_TIME_CONST
     #: Take-off as ArduPlane SITL's stock plane flies it at full throttle (fitted to the
     #: recorded climbs): ground roll accelerating at this rate, lift-off at 85 % of the cruise
     #: airspeed, climb at this rate up to 116 % of it.  0: airborne at once, climbing at the
     #: take-off pitch.
-    takeoff_accel_m_s2: float = 0.0
+    takeoff_accel_m_s2: float = TAKEOFF_ACCEL_M_S2
     takeoff_climb_m_s: float = 9.7
     #: Turn rate over the coordinated-turn rate g tan(bank) / v at the same bank: 1 for an
-    #: ideal airframe; ArduPlane SITL's stock plane turns at about 0.76 of it (regression of
-    #: the recorded course rate on the recorded roll, 0.73-0.80 over the cases).
-    turn_efficiency: float = 1.0
+    #: ideal airframe; ArduPlane SITL's stock plane turns at SITL_TURN_EFFICIENCY of it.
+    turn_efficiency: float = SITL_TURN_EFFICIENCY
     #: How often the navigation runs (lateral demand, waypoint completion); 0: every step.
-    navigation_hz: float = 0.0
+    navigation_hz: float = ARDUPLANE_DEFAULTS.SCHED_LOOP_RATE
     #: ArduPlane's NAVL1_XTRACK_I: the cross-track integrator's gain (0: none).
-    xtrack_i_gain: float = 0.0
+    xtrack_i_gain: float = ARDUPLANE_DEFAULTS.NAVL1_XTRACK_I
 
     @classmethod
     def from_parameters(cls, parameters: VehicleParameters = ARDUPLANE_DEFAULTS,
                         airspeed_m_s: float | None = None) -> "Airframe":
         """The airframe an ArduPlane with these parameters flies as (its cruise airspeed
         unless ``airspeed_m_s`` is given)."""
-        speed = airspeed_m_s or parameters.AIRSPEED_CRUISE
-        roll = math.radians(parameters.ROLL_LIMIT_DEG)
-        return cls(speed, speed ** 2 / (G * math.tan(roll)), parameters.NAVL1_PERIOD,
-                   parameters.WP_RADIUS, l1_damping=parameters.NAVL1_DAMPING,
-                   roll_limit_deg=parameters.ROLL_LIMIT_DEG,
-                   loiter_radius_m=parameters.WP_LOITER_RAD,
+        return cls(airspeed_m_s or parameters.AIRSPEED_CRUISE, parameters.ROLL_LIMIT_DEG,
+                   parameters.NAVL1_PERIOD, parameters.WP_RADIUS,
+                   l1_damping=parameters.NAVL1_DAMPING, loiter_radius_m=parameters.WP_LOITER_RAD,
                    max_climb_m_s=parameters.TECS_CLMB_MAX, max_sink_m_s=parameters.TECS_SINK_MAX,
-                   altitude_time_constant_s=parameters.TECS_TIME_CONST, takeoff_accel_m_s2=TAKEOFF_ACCEL_M_S2,
-                   turn_efficiency=SITL_TURN_EFFICIENCY, navigation_hz=parameters.SCHED_LOOP_RATE,
+                   altitude_time_constant_s=parameters.TECS_TIME_CONST,
+                   navigation_hz=parameters.SCHED_LOOP_RATE,
                    xtrack_i_gain=parameters.NAVL1_XTRACK_I)
 
-    def max_bank_rad(self, airspeed_m_s: float) -> float:
-        if self.roll_limit_deg is not None:
-            return math.radians(self.roll_limit_deg)
-        return math.atan(airspeed_m_s ** 2 / (G * self.min_turn_radius_m))
+    @classmethod
+    def turning_at(cls, rho_m: float, airspeed_m_s: float | None = None,
+                   parameters: VehicleParameters = ARDUPLANE_DEFAULTS) -> "Airframe":
+        """The aircraft of ``parameters`` (at ``airspeed_m_s``, else its cruise airspeed) with
+        the roll limit at which it turns no tighter than ``rho_m`` in still air."""
+        return cls.from_parameters(parameters_with(parameters, airspeed_m_s, rho_m=rho_m))
+
+    def max_bank_rad(self, airspeed_m_s: float | None = None) -> float:
+        return math.radians(self.roll_limit_deg)
 
     def l1_distance_m(self, speed_m_s: float) -> float:
         return max(self.l1_damping * self.l1_period_s * speed_m_s / math.pi, 1.0)
 
+    def turn_radius_m(self, bank_deg: float, airspeed_m_s: float | None = None) -> float:
+        """The radius (through the air) of this aircraft's steady turn at ``bank_deg`` and
+        ``airspeed_m_s`` (its cruise airspeed if None): the radius the flight model flies."""
+        v = self.airspeed_m_s if airspeed_m_s is None else airspeed_m_s
+        return v / K.turn_rate_rad_s(v, math.radians(bank_deg), self.turn_efficiency)
+
     @property
     def tightest_turn_m(self) -> float:
-        """The smallest radius the model flies in still air at the cruise airspeed: full bank,
-        at its turn efficiency."""
-        v = self.airspeed_m_s
-        return v * v / (self.turn_efficiency * G * math.tan(self.max_bank_rad(v)))
+        """The smallest radius the model flies in still air at the cruise airspeed: its roll
+        limit, at its turn efficiency."""
+        return self.turn_radius_m(self.roll_limit_deg)
 
 
 @dataclass(frozen=True)
@@ -167,12 +170,32 @@ def parameters_with(parameters: VehicleParameters, airspeed_m_s: float | None = 
         if max_bank_deg is None:
             if not rho_m > 0:
                 raise InputError(f"the turn radius must be above 0 m, got {rho_m:g}")
-            speed = parameters.AIRSPEED_CRUISE
-            max_bank_deg = math.degrees(math.atan(speed ** 2 / (G * rho_m * SITL_TURN_EFFICIENCY)))
+            max_bank_deg = bank_for_radius_deg(rho_m, parameters.AIRSPEED_CRUISE)
         if not 0 < max_bank_deg < 90:
             raise InputError(f"the maximum bank must be between 0 and 90 deg, got {max_bank_deg:g}")
         parameters = replace(parameters, ROLL_LIMIT_DEG=max_bank_deg)
     return parameters
+
+
+def check_turn_radius(rho_m: float, parameters: VehicleParameters = ARDUPLANE_DEFAULTS,
+                      airspeed_m_s: float | None = None) -> None:
+    """:class:`InputError` if the aircraft of ``parameters`` (at ``airspeed_m_s``, else its
+    cruise airspeed) cannot turn at ``rho_m`` within its roll limit, naming the smallest
+    radius it can."""
+    airframe = Airframe.from_parameters(parameters, airspeed_m_s)
+    tightest = airframe.tightest_turn_m
+    if rho_m < tightest * (1 - 1e-9):
+        raise InputError(
+            f"the aircraft cannot turn at {rho_m:g} m: at {airframe.airspeed_m_s:g} m/s with a roll "
+            f"limit of {parameters.ROLL_LIMIT_DEG:g} deg (ROLL_LIMIT_DEG) it turns no "
+            f"tighter than {math.ceil(tightest):.0f} m; plan with a radius of at least that")
+
+
+def bank_for_radius_deg(rho_m: float, airspeed_m_s: float,
+                        turn_efficiency: float = SITL_TURN_EFFICIENCY) -> float:
+    """The bank at which the aircraft (turning at ``turn_efficiency`` of the coordinated
+    rate) turns at ``rho_m`` at ``airspeed_m_s``: the inverse of :meth:`Airframe.turn_radius_m`."""
+    return math.degrees(math.atan(airspeed_m_s ** 2 / (G * rho_m * turn_efficiency)))
 
 
 def launch_heading_rad(items: list[LocalItem], first: int) -> float:
@@ -247,13 +270,12 @@ def airframe_vector(airframe: Airframe, wind: Wind = CALM) -> np.ndarray:
     """The airframe, its tuning and the wind as the compiled model's vector."""
     v = np.zeros(K.AIRFRAME_SIZE)
     v[K.A_AIRSPEED] = airframe.airspeed_m_s
-    v[K.A_MIN_RADIUS] = airframe.min_turn_radius_m
     v[K.A_L1_PERIOD] = airframe.l1_period_s
     v[K.A_WP_RADIUS] = airframe.wp_radius_m
     v[K.A_ROLL_W] = airframe.roll_natural_rad_s
     v[K.A_ROLL_Z] = airframe.roll_damping
     v[K.A_L1_DAMPING] = airframe.l1_damping
-    v[K.A_ROLL_LIMIT] = math.nan if airframe.roll_limit_deg is None else airframe.roll_limit_deg
+    v[K.A_ROLL_LIMIT] = airframe.roll_limit_deg
     v[K.A_LOITER_RADIUS] = airframe.loiter_radius_m
     v[K.A_CLIMB] = airframe.max_climb_m_s
     v[K.A_SINK] = airframe.max_sink_m_s

@@ -10,6 +10,7 @@ from __future__ import annotations
 
 import json
 import math
+import re
 from dataclasses import dataclass, field
 
 import click
@@ -36,6 +37,24 @@ console_options = [
 ]
 
 
+#: The library names the parameters a user sets in backticks, in its own terms (`max_items`);
+#: a command prints the option that sets each.  Names not listed are printed as they are.
+OPTIONS = {
+    "max_items": "--max-items", "max_miss_m": "--max-miss", "min_altitude_m": "--min-alt",
+    "gimbal_pitch_deg": "--gimbal-pitch", "loiter_turns": "--loiter",
+    "loiter_radius_m": "--loiter-radius", "wind": "--wind", "wind_spread_m_s": "--wind-spread",
+    "tolerance_m": "--tolerance", "endurance_s": "--endurance", "return_mode": "--return",
+    "airspeed_m_s": "--airspeed", "autopilot": "--autopilot", "origin": "--origin",
+    "signing_key": "--signing-key", "via": "--via", "verify=False": "--no-verify",
+    "count": "--random", "format_name": "--format",
+}
+
+
+def in_cli_terms(text: str) -> str:
+    """``text`` with each parameter the library names in backticks replaced by its option."""
+    return re.sub(r"`([^`]+)`", lambda match: OPTIONS.get(match.group(1), match.group(0)), text)
+
+
 def start(quiet: bool = False, as_json: bool = False) -> Console:
     """The console of the command now running."""
     global _current
@@ -50,11 +69,12 @@ def current() -> Console:
 def say(text: str) -> None:
     """A line of the report (standard error with --json; nothing with -q)."""
     if not _current.quiet:
-        click.echo(text, err=_current.as_json)
+        click.echo(in_cli_terms(text), err=_current.as_json)
 
 
 def note(text: str) -> None:
     """A note: kept for the summary, shown on standard error unless -q."""
+    text = in_cli_terms(text)
     _current.notes.append(text)
     if not _current.quiet:
         click.echo(f"note: {text}", err=True)

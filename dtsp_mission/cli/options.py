@@ -12,12 +12,17 @@ from typing import Callable
 import click
 
 from ..errors import DtspError
+from .console import in_cli_terms
 
 
 class UserError(click.ClickException):
-    """A message for the user and exit code 2, with nothing half-written."""
+    """A message for the user and exit code 2, with nothing half-written; the parameters the
+    library names (in backticks) are printed as the options that set them."""
 
     exit_code = 2
+
+    def __init__(self, message: str) -> None:
+        super().__init__(in_cli_terms(message))
 
 
 def reports_errors(function: Callable) -> Callable:
@@ -88,7 +93,7 @@ class WindType(click.ParamType):
         try:
             return check_wind(Wind(speed, direction % 360.0 if math.isfinite(direction) else direction))
         except InputError as error:
-            self.fail(str(error), param, ctx)
+            self.fail(in_cli_terms(str(error)), param, ctx)
 
 
 WIND = WindType()
@@ -100,7 +105,7 @@ vehicle_options = [
                       "and --max-bank)."),
     click.option("--airspeed", "airspeed_m_s", type=float, metavar="M/S",
                  help="Cruise airspeed in m/s: sets the mission speed and the flight time; with "
-                      "--max-bank it gives rho = v^2 / (g tan(bank))."),
+                      "--max-bank it gives rho, the radius the aircraft turns at that bank."),
     click.option("--max-bank", "max_bank_deg", type=float, metavar="DEG",
                  help="Largest bank angle in degrees, used with --airspeed to compute rho."),
 ]
@@ -115,7 +120,7 @@ mission_options = [
                  "below it (lower it only where the site is clear that low)."),
     click.option("--home", "home_deg", type=LAT_LON,
                  help="Launch and home position (default: the centre of the targets)."),
-    click.option("--home-amsl", "home_amsl_m", type=float, default=0.0, show_default=True,
+    click.option("--home-amsl", "home_altitude_amsl_m", type=float, default=0.0, show_default=True,
                  metavar="METRES", help="Home altitude above mean sea level (for the .plan)."),
     click.option("--launch-bearing", "launch_bearing_deg", type=float, metavar="DEG",
                  help="Take-off direction, compass degrees (default: towards the first target)."),
@@ -150,21 +155,12 @@ mission_options = [
 ]
 
 
-def mission_settings(autopilot, altitude_m, airspeed_m_s, home_deg, home_amsl_m,
-                     launch_bearing_deg, landing_bearing_deg, return_mode, design, max_miss_m,
-                     tolerance_m, max_items, vehicle=None, wind=None, wind_spread_m_s=None,
-                     min_altitude_m=30.0, **actions):
-    """The :class:`MissionSettings` of the :data:`mission_options` values (``vehicle``: the
-    :class:`~dtsp_mission.autopilot.parameters.VehicleParameters` the mission is for;
-    ``actions``: photo, roi, gimbal_pitch_deg, loiter_radius_m)."""
-    from ..autopilot.navigation import CALM
+def mission_settings(**values):
+    """The :class:`MissionSettings` of option values named as its fields (``vehicle``: the
+    :class:`~dtsp_mission.autopilot.parameters.VehicleParameters` the mission is for; a value
+    of None takes the field's default)."""
     from ..mission import MissionSettings
-    return MissionSettings(autopilot, altitude_m, airspeed_m_s, home_deg, home_amsl_m,
-                           launch_bearing_deg, landing_bearing_deg, return_mode, tolerance_m,
-                           max_items, design=design, max_miss_m=max_miss_m, vehicle=vehicle,
-                           wind=wind if wind is not None else CALM,
-                           wind_spread_m_s=wind_spread_m_s, min_altitude_m=min_altitude_m,
-                           **actions)
+    return MissionSettings(**{name: value for name, value in values.items() if value is not None})
 
 
 def apply(options: list) -> Callable:
@@ -177,30 +173,31 @@ def apply(options: list) -> Callable:
 
 
 def turn_radius_from(rho_m: float | None, airspeed_m_s: float | None,
-                     max_bank_deg: float | None, roll_limit_deg: float | None = None) -> tuple[float, str]:
-    """The turn radius and where it came from, from the vehicle options; UserError for a
-    radius the aircraft cannot turn at its airspeed (a bank beyond ``roll_limit_deg``, its
-    ROLL_LIMIT_DEG: a stock ArduPlane's unless given)."""
+                     max_bank_deg: float | None, parameters=None) -> tuple[float, str]:
+    """The turn radius and where it came from, from the vehicle options: ``--radius``, or the
+    radius the aircraft (``parameters``: a stock ArduPlane's unless given) turns at
+    ``--max-bank`` and ``--airspeed``.  UserError for options that do not go together;
+    InputError for a radius the aircraft cannot turn at ``--airspeed``."""
+    from ..autopilot.navigation import Airframe, bank_for_radius_deg, check_turn_radius
     from ..autopilot.parameters import ARDUPLANE_DEFAULTS
-    from ..vehicle import bank_for_radius_deg, turn_radius_m
-    limit = ARDUPLANE_DEFAULTS.ROLL_LIMIT_DEG if roll_limit_deg is None else roll_limit_deg
+    parameters = parameters or ARDUPLANE_DEFAULTS
     if max_bank_deg is not None:
         if rho_m is not None:
             raise UserError("give either --radius or --airspeed with --max-bank, not both")
         if airspeed_m_s is None:
             raise UserError("--max-bank needs --airspeed to compute the turn radius")
-        rho = turn_radius_m(airspeed_m_s, max_bank_deg)
-        return rho, (f"rho {rho:.1f} m from airspeed {airspeed_m_s:g} m/s and "
+        if not (math.isfinite(max_bank_deg) and 0 < max_bank_deg < 90):
+            raise UserError(f"--max-bank must be between 0 and 90 degrees, got {max_bank_deg:g}")
+        if not (math.isfinite(airspeed_m_s) and airspeed_m_s > 0):
+            raise UserError(f"--airspeed must be a number above 0 m/s, got {airspeed_m_s:g}")
+        rho = Airframe.from_parameters(parameters, airspeed_m_s).turn_radius_m(max_bank_deg)
+        return rho, (f"rho {rho:.1f} m: the aircraft's turn at {airspeed_m_s:g} m/s and "
                      f"{max_bank_deg:g} deg bank")
     if rho_m is None:
         raise UserError("give the turn radius: --radius METRES, or --airspeed and --max-bank")
     if airspeed_m_s is not None and rho_m > 0 and airspeed_m_s > 0:
-        bank = bank_for_radius_deg(airspeed_m_s, rho_m)
-        if bank > limit:
-            raise UserError(f"--radius {rho_m:g} m at {airspeed_m_s:g} m/s needs {bank:.0f} deg "
-                            f"of bank, beyond the aircraft's roll limit of {limit:g} deg "
-                            f"(ROLL_LIMIT_DEG): at that speed it turns no tighter than "
-                            f"{turn_radius_m(airspeed_m_s, limit):.0f} m")
+        check_turn_radius(rho_m, parameters, airspeed_m_s)
+        bank = bank_for_radius_deg(rho_m, airspeed_m_s)
         return rho_m, (f"rho {rho_m:g} m (a {bank:.0f} deg bank at {airspeed_m_s:g} m/s)")
     return rho_m, f"rho {rho_m:g} m"
 

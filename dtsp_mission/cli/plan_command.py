@@ -9,14 +9,13 @@ from pathlib import Path
 import click
 import numpy as np
 
-from ..dubins.path import check_radius
 from ..export import exporter_for
 from ..errors import DtspError
 from ..files import check_replaceable, write_together
 from ..mission import Autopilot, MissionSettings
-from ..mission.build import targets_beyond
+from ..mission.widening import targets_beyond
 from ..mission.sorties import sortie_path
-from ..pipeline import PlanRequest, PlanResult, run_plan
+from ..pipeline import PlanRequest, PlanResult, check_request, run_plan
 from ..planning import planners
 from ..planning.base import MERGE_RESOLUTION_RHO
 from ..planning.rbta import region_heading_deg
@@ -28,7 +27,6 @@ from ..targets.actions import TargetActions, check_loiter_turns
 from ..targets.geojson_file import read_geojson
 from . import console
 from .console import console_options, note, record, say
-from ..autopilot.navigation import CALM
 from .options import (FiniteFloatRange, LAT_LON, UserError, airframe_from, apply,
                       designed_for as designed_for_file, link_options, mission_options,
                       mission_settings, progress_reporter, reports_errors, seed_option,
@@ -152,7 +150,7 @@ def _duration(seconds: float) -> str:
 @apply(console_options)
 @reports_errors
 def plan(targets_file, random_count, area_file, seed, origin, rho_m, airspeed_m_s, max_bank_deg,
-         altitude_m, min_altitude_m, home_deg, home_amsl_m, launch_bearing_deg, landing_bearing_deg, autopilot,
+         altitude_m, min_altitude_m, home_deg, home_altitude_amsl_m, launch_bearing_deg, landing_bearing_deg, autopilot,
          return_mode, design, max_miss_m, wind_spread_m_s, tolerance_m, max_items, algorithm, region, time_limit_s,
          fallback, outputs, format_name,
          plot_file, connection, via, verify, signing_key_file, transfer_timeout_s, endurance_min,
@@ -168,52 +166,35 @@ def plan(targets_file, random_count, area_file, seed, origin, rho_m, airspeed_m_
     Example: dtsp-mission plan examples/site-inspection.csv --radius 80 --alt 120 -o mission.plan
     """
     console.start(quiet, as_json)
-    if endurance_min is not None and airspeed_m_s is None:
-        raise UserError("--endurance needs --airspeed: the flight time follows from it")
     writers = [(output, exporter_for(output, format_name)) for output in outputs]
     if plot_file:
         require_matplotlib()
         plot_format(plot_file)
     _check_writable([*outputs, *([plot_file] if plot_file else [])])
-    if max_items is not None:      # a budget no vehicle can have is refused before planning
-        MissionSettings(max_items=max_items).checked(1.0)
     if algorithm in ("rbta", "auto") and region not in ("bounding", "min-area"):
         region_heading_deg(region)
     designed_for = designed_for_file(vehicle_params_file)
-    rho, rho_source = turn_radius_from(rho_m, airspeed_m_s, max_bank_deg,
-                                       designed_for.ROLL_LIMIT_DEG if designed_for else None)
-    check_radius(rho)
+    rho, rho_source = turn_radius_from(rho_m, airspeed_m_s, max_bank_deg, designed_for)
     targets = _targets(targets_file, random_count, area_file, seed, rho)
-    if len(targets) < 2:
-        raise UserError(f"{targets_file or 'the input'} holds {len(targets)} target(s) after "
-                        "merging duplicates; a tour needs at least 2 (for one point, fly a "
-                        "single waypoint)")
     if targets.unused_columns:
         note(f"{targets_file}: columns not used: {', '.join(targets.unused_columns)} (the "
              "columns read are lat/lon or x/y, alt, name, photo, roi, gimbal_pitch and "
              "loiter_turns)")
     if loiter_specs:
         targets = with_loiters(targets, loiter_specs)
-    if isinstance(targets, GeoTargets) and origin is not None:
-        raise UserError("--origin is for targets in local x/y metres; these are in lat/lon")
-    geographic = isinstance(targets, GeoTargets) or origin is not None
-    needs_mission = [output for output, writer in writers if writer.needs_mission]
-    if needs_mission and not geographic:
-        raise UserError(f"{needs_mission[0]}: a mission needs targets in degrees; these are "
-                        "local x/y metres, so give --origin LAT,LON (or write only a .json tour)")
-    if (connection or simulate) and not geographic:
-        raise UserError("--upload and --simulate need a mission in degrees: targets in lat/lon, "
-                        "or local x/y with --origin")
+    needs_mission = any(writer.needs_mission for _, writer in writers) or connection or simulate
+    # Targets on the earth get a mission (a tour-only output checks its storage); local x/y
+    # without --origin get the tour only, unless a mission is asked for (then refused).
     settings = None
-    if geographic:
-        settings = mission_settings(autopilot, altitude_m, airspeed_m_s, home_deg, home_amsl_m,
-                                    launch_bearing_deg, landing_bearing_deg, return_mode, design,
-                                    max_miss_m, tolerance_m, max_items, designed_for,
-                                    photo=photo, roi=roi, gimbal_pitch_deg=gimbal_pitch_deg,
-                                    loiter_radius_m=loiter_radius_m, wind=wind or CALM,
-                                    wind_spread_m_s=wind_spread_m_s,
-                                    min_altitude_m=min_altitude_m)
-        settings.checked(rho)          # refused before planning, not after
+    if needs_mission or isinstance(targets, GeoTargets) or origin is not None:
+        settings = mission_settings(
+            vehicle=designed_for, autopilot=autopilot, altitude_m=altitude_m,
+            min_altitude_m=min_altitude_m, airspeed_m_s=airspeed_m_s, home_deg=home_deg,
+            home_altitude_amsl_m=home_altitude_amsl_m, launch_bearing_deg=launch_bearing_deg,
+            landing_bearing_deg=landing_bearing_deg, return_mode=return_mode, design=design,
+            max_miss_m=max_miss_m, wind=wind, wind_spread_m_s=wind_spread_m_s,
+            tolerance_m=tolerance_m, max_items=max_items, photo=photo, roi=roi,
+            gimbal_pitch_deg=gimbal_pitch_deg, loiter_radius_m=loiter_radius_m)
         if autopilot == "px4" and any(writer.name == "waypoints" for _, writer in writers):
             note("a .waypoints file holds the home in its row 0, as QGroundControl, Mission "
                  "Planner and MAVProxy read it; a tool that sends every row would make it PX4's "
@@ -225,10 +206,12 @@ def plan(targets_file, random_count, area_file, seed, origin, rho_m, airspeed_m_
     # Only tour files asked for: the mission is not designed (minutes of predicted flights
     # for the guidance design), only checked against the vehicle's storage.  Without any
     # output the mission is designed: its report is what was asked for.
-    tour_only = bool(writers) and not (needs_mission or connection or simulate or plot_file)
-    request = PlanRequest(targets, rho, algorithm, parameters, fallback, origin, settings,
+    tour_only = bool(writers) and not (needs_mission or plot_file)
+    request = PlanRequest(targets=targets, rho_m=rho, algorithm=algorithm, parameters=parameters,
+                          fallback=fallback, origin=origin, settings=settings,
                           too_large="note" if tour_only else "split",
                           endurance_s=endurance_min and endurance_min * 60)
+    check_request(request)           # every check of the request, before any planning
     from ..compiled import kernels_cached
     if not kernels_cached():
         note("first run on this machine: compiling the planning kernels (about a minute, "
@@ -402,32 +385,32 @@ def _report_tour(result: PlanResult) -> None:
                    f"{tour.report['leftover_length_m']:,.1f} m")
 
 
-def _wind_text(wind: dict) -> str:
-    return ("calm" if wind["speed_m_s"] == 0 else
-            f"in a wind of {wind['speed_m_s']:g} m/s from {wind['from_deg']:g} deg")
+def _wind_text(wind: tuple[float, float]) -> str:
+    speed, from_deg = wind
+    return "calm" if speed == 0 else f"in a wind of {speed:g} m/s from {from_deg:g} deg"
 
 
 def _report_mission(mission) -> None:
-    summary = mission.summary
+    summary, guidance = mission.summary, mission.guidance
     flavour = "ArduPilot" if mission.autopilot == Autopilot.ARDUPILOTMEGA else "PX4"
-    if "predicted_miss_m" in summary:
-        misses = np.asarray(summary["predicted_miss_m"])
+    if guidance is not None:
+        misses = guidance.predicted_miss_m
         say(f"mission ({flavour}): {summary['items']} items ({summary['items'] / len(misses):.2f} "
-                   f"per target, {summary['shaping_waypoints']} shaping waypoints), "
-                   f"{summary['vehicle_slots']} vehicle slots; designed for the autopilot's "
-                   f"guidance: targets passed within median {np.median(misses):.1f} m, max "
-                   f"{misses.max():.1f} m in the flight model, {_wind_text(summary['design_wind'])}")
-        say(f"  predicted flight {summary['predicted_flight_m'] / 1e3:,.2f} km against "
-                   f"{summary['planned_flight_m'] / 1e3:,.2f} km of exact path (take-off to the "
-                   "last target, and its loiter if it has one)")
+            f"per target, {guidance.shaping_waypoints} shaping waypoints), "
+            f"{summary['vehicle_slots']} vehicle slots; designed for the autopilot's "
+            f"guidance: targets passed within median {np.median(misses):.1f} m, max "
+            f"{misses.max():.1f} m in the flight model, {_wind_text(guidance.design_wind)}")
+        say(f"  predicted flight {guidance.predicted_flight_m / 1e3:,.2f} km against "
+            f"{guidance.planned_flight_m / 1e3:,.2f} km of exact path (take-off to the "
+            "last target, and its loiter if it has one)")
     else:
         say(f"mission ({flavour}): {summary['items']} items, {summary['vehicle_slots']} "
-                   f"vehicle slots; waypoints within {mission.tolerance_m:.2f} m of the exact path")
+            f"vehicle slots; waypoints within {mission.tolerance_m:.2f} m of the exact path")
     record(autopilot=flavour, items=summary["items"], mission_slots=summary["vehicle_slots"],
            flight_length_m=summary["flight_length_m"], flight_time_s=summary.get("flight_time_s"))
-    if "predicted_miss_m" in summary:
+    if guidance is not None:
         record(predicted_miss_m=summary["predicted_miss_m"],
-               predicted_flight_m=summary["predicted_flight_m"], design_wind=summary["design_wind"])
+               predicted_flight_m=guidance.predicted_flight_m, design_wind=summary["design_wind"])
     if "actions" in summary:
         say("  actions at the targets: " + ", ".join(f"{count} {role}" for role, count in
                                                       summary["actions"].items()))

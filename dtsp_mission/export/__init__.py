@@ -2,7 +2,7 @@
 
 Every exporter, built-in or third-party, registers in the ``dtsp_mission.exporters``
 entry-point group as an :class:`Exporter` subclass; :func:`exporters` lists them and
-:func:`exporter_for` picks one from ``--format`` or the file extension.
+:func:`exporter_for` picks one by name (``format_name``) or from the file extension.
 """
 
 from __future__ import annotations
@@ -42,7 +42,7 @@ def exporter_for(path: str | os.PathLike, format_name: str | None = None,
         known = ", ".join(sorted(ext for e in available.values() for ext in e.extensions))
         raise InputError(f"{path}: cannot tell the {'mission' if reading else 'output'} format "
                          f"from the file name; {'this reads' if reading else 'use'} one of "
-                         f"{known}, or --format")
+                         f"{known}, or name the format (`format_name`)")
     return available[max(matches)[1]]()
 
 

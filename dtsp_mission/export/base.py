@@ -58,7 +58,7 @@ class Exporter:
         formats that can say where it is (:meth:`render_tour`)."""
         if self.needs_mission and not isinstance(product, Mission):
             raise InputError(f"{path}: a {self.description or self.name} needs a mission in "
-                             "degrees; give targets in lat/lon, or local x/y with --origin")
+                             "degrees; give targets in lat/lon, or local x/y with an `origin`")
         if isinstance(product, Tour) and frame is not None:
             return self.render_tour(product, frame)
         return self.render(product)

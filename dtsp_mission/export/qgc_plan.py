@@ -61,7 +61,7 @@ def plan_dict(mission: Mission) -> dict[str, Any]:
         "geoFence": {"circles": [], "polygons": [], "version": 2},
         "rallyPoints": {"points": [], "version": 2},
     }
-    if "design_wind" in mission.summary:     # readers ignore keys they do not know
+    if mission.guidance is not None:     # readers ignore keys they do not know
         document["dtspMission"] = {"designWind": mission.summary["design_wind"]}
     return document
 

@@ -166,8 +166,56 @@ class FlightPath:
 
 
 @dataclass(frozen=True)
+class GuidancePrediction:
+    """What the guidance design predicts of its mission in the flight model.
+
+    Per target (target order), in metres: ``predicted_miss_m`` in the forecast wind,
+    ``worst_wind_miss_m`` the worst over the design winds, ``judged_miss_m`` the miss the
+    design is judged by (the forecast's, or the worst of the others less the model's margin,
+    whichever is further beyond its limit: held when at most ``design_limit_m``).  The
+    predicted flight and the planned one over the same span, the shaping waypoints added, the
+    predicted flights made, the forecast wind (speed m/s, from deg) with its spread (m/s) and
+    the winds flown.
+    """
+
+    predicted_miss_m: np.ndarray
+    judged_miss_m: np.ndarray
+    worst_wind_miss_m: np.ndarray
+    design_limit_m: float
+    predicted_flight_m: float
+    planned_flight_m: float
+    shaping_waypoints: int
+    design_rounds: int
+    design_wind: tuple[float, float]
+    wind_spread_m_s: float
+    design_winds: tuple[tuple[float, float], ...]
+
+    def targets_beyond(self, limit_m: float | None = None) -> int:
+        """Targets not held: judged beyond the design limit; with ``limit_m``, predicted
+        beyond it in the forecast wind."""
+        if limit_m is None:
+            return int((self.judged_miss_m > self.design_limit_m).sum())
+        return int((self.predicted_miss_m > limit_m).sum())
+
+    def as_summary(self) -> dict[str, Any]:
+        """The prediction as plain values (the report's and the JSON summary's keys)."""
+        speed, from_deg = self.design_wind
+        return {"predicted_miss_m": self.predicted_miss_m.tolist(),
+                "judged_miss_m": self.judged_miss_m.tolist(),
+                "worst_wind_miss_m": self.worst_wind_miss_m.tolist(),
+                "predicted_flight_m": self.predicted_flight_m,
+                "planned_flight_m": self.planned_flight_m,
+                "shaping_waypoints": self.shaping_waypoints, "design_rounds": self.design_rounds,
+                "design_wind": {"speed_m_s": speed, "from_deg": from_deg,
+                                "spread_m_s": self.wind_spread_m_s},
+                "design_winds": [list(w) for w in self.design_winds],
+                "design_limit_m": self.design_limit_m}
+
+
+@dataclass(frozen=True)
 class Mission:
-    """Mission items with everything exporters need to describe them."""
+    """Mission items with everything exporters need to describe them; ``guidance`` is what
+    the guidance design predicts of it (None for the geometric design)."""
 
     items: tuple[MissionItem, ...]
     home: Home
@@ -182,6 +230,7 @@ class Mission:
     notes: tuple[str, ...] = ()        # decisions the user should know about
     summary: dict[str, Any] = field(default_factory=dict)
     targets_deg: tuple[np.ndarray, np.ndarray] | None = None   # the input's latitudes, longitudes
+    guidance: GuidancePrediction | None = None
 
     @property
     def target_items(self) -> list[int]:
@@ -206,10 +255,8 @@ class Mission:
         return numbers
 
     def for_vehicle(self) -> VehicleMission:
-        wind = self.summary.get("design_wind")
         return VehicleMission(self.items, self.home, self.autopilot,
-                              design_wind=None if wind is None else (wind["speed_m_s"],
-                                                                     wind["from_deg"]))
+                              design_wind=None if self.guidance is None else self.guidance.design_wind)
 
     def vehicle_item_count(self) -> int:
         """Mission slots on the vehicle: the items plus ArduPilot's home at seq 0."""

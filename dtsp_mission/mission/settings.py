@@ -19,7 +19,7 @@ from ..targets import GeoTargets
 from ..targets.actions import check_gimbal_pitch
 from ..targets.model import MAX_ALTITUDE_M
 from ..autopilot.commands import AUTOPILOTS
-from ..autopilot.navigation import CALM, MAX_WIND_M_S, Airframe, Wind, check_wind
+from ..autopilot.navigation import CALM, MAX_WIND_M_S, Wind, check_turn_radius, check_wind
 from ..autopilot.parameters import ARDUPLANE_DEFAULTS, VehicleParameters
 from ..autopilot.storage import MAVLINK_MAX_ITEMS, capacity
 from .flight_path import TAKEOFF_CLIMB_DEG
@@ -104,11 +104,11 @@ class MissionSettings:
                              f"{MAX_ALTITUDE_M:g} m, higher than the fixed wings this plans for "
                              "fly (a typo, or feet for metres?)")
         if not (math.isfinite(self.min_altitude_m) and 0 < self.min_altitude_m <= MAX_ALTITUDE_M):
-            raise InputError(f"the altitude floor (--min-alt) must be a number of metres above 0, "
+            raise InputError(f"the altitude floor (`min_altitude_m`) must be a number of metres above 0, "
                              f"got {self.min_altitude_m!r}")
         if self.altitude_m < self.min_altitude_m:
             raise InputError(f"altitude {self.altitude_m:g} m above home is below the floor of "
-                             f"{self.min_altitude_m:g} m (--min-alt); if the site is clear that "
+                             f"{self.min_altitude_m:g} m (`min_altitude_m`); if the site is clear that "
                              "low, lower the floor explicitly")
         if self.airspeed_m_s is not None and not (math.isfinite(self.airspeed_m_s)
                                                   and self.airspeed_m_s > 0):
@@ -122,22 +122,22 @@ class MissionSettings:
                              f"({rho_m:g} m), got {tolerance!r}")
         max_items = DEFAULT_MAX_ITEMS[self.autopilot] if self.max_items is None else self.max_items
         if max_items < 1:
-            raise InputError(f"max_items (--max-items) must be at least 1, got {max_items}")
+            raise InputError(f"`max_items` must be at least 1, got {max_items}")
         if max_items > MAVLINK_MAX_ITEMS:
-            raise InputError(f"max_items (--max-items) {max_items} is more than MAVLink can address: a "
+            raise InputError(f"`max_items` {max_items} is more than MAVLink can address: a "
                              f"mission has at most {MAVLINK_MAX_ITEMS} items (16-bit sequence numbers)")
         if self.design not in DESIGNS:
             raise InputError(f"unknown waypoint design {self.design!r}; choose {', '.join(DESIGNS)}")
         if not (math.isfinite(self.max_miss_m) and self.max_miss_m > 0):
-            raise InputError(f"max_miss_m (--max-miss) must be a number above 0 m, got {self.max_miss_m!r}")
+            raise InputError(f"`max_miss_m` must be a number above 0 m, got {self.max_miss_m!r}")
         if not (math.isfinite(self.home_altitude_amsl_m) and abs(self.home_altitude_amsl_m) < 1e4):
             raise InputError(f"home altitude must be a number of metres above sea level, got "
                              f"{self.home_altitude_amsl_m!r}")
         if self.gimbal_pitch_deg is not None:
-            check_gimbal_pitch(self.gimbal_pitch_deg, "gimbal_pitch_deg (--gimbal-pitch)")
+            check_gimbal_pitch(self.gimbal_pitch_deg, "`gimbal_pitch_deg`")
         if self.loiter_radius_m is not None and not (math.isfinite(self.loiter_radius_m)
                                                      and rho_m <= self.loiter_radius_m <= 2550.0):
-            raise InputError(f"loiter_radius_m (--loiter-radius) must be from the turn radius "
+            raise InputError(f"`loiter_radius_m` must be from the turn radius "
                              f"({rho_m:g} m) to 2,550 m (the most ArduPilot stores), got "
                              f"{self.loiter_radius_m!r}")
         airspeed = self.airspeed_m_s or (self.vehicle or ARDUPLANE_DEFAULTS).AIRSPEED_CRUISE
@@ -145,21 +145,15 @@ class MissionSettings:
         spread = (max(MIN_WIND_SPREAD_M_S, DEFAULT_WIND_SPREAD * self.wind.speed_m_s)
                   if self.wind_spread_m_s is None else self.wind_spread_m_s)
         if not (math.isfinite(spread) and 0 <= spread <= MAX_WIND_M_S):
-            raise InputError(f"the wind spread (--wind-spread) must be from 0 to "
+            raise InputError(f"the wind spread (`wind_spread_m_s`) must be from 0 to "
                              f"{MAX_WIND_M_S:g} m/s, got {spread!r}")
         check_wind(Wind(self.wind.speed_m_s + spread, self.wind.from_deg), airspeed)
-        if self.vehicle is not None or self.design == "guidance":
-            parameters = self.vehicle or ARDUPLANE_DEFAULTS
-            tightest = Airframe.from_parameters(parameters, self.airspeed_m_s).tightest_turn_m
-            if rho_m < tightest * (1 - 1e-9):
-                raise InputError(
-                    f"the aircraft cannot turn at {rho_m:g} m: at {airspeed:g} m/s with a roll "
-                    f"limit of {parameters.ROLL_LIMIT_DEG:g} deg (ROLL_LIMIT_DEG) it turns no "
-                    f"tighter than {tightest:.0f} m; plan with a radius of at least that")
+        if self.vehicle is not None or self.design == "guidance" or self.airspeed_m_s is not None:
+            check_turn_radius(rho_m, self.vehicle or ARDUPLANE_DEFAULTS, self.airspeed_m_s)
         margin = MODEL_MARGIN_M if self.model_margin_m is None else self.model_margin_m
         if not (math.isfinite(margin) and 0 <= margin <= self.max_miss_m - MIN_DESIGN_LIMIT_M):
             raise InputError(f"the model margin must be from 0 m to {MIN_DESIGN_LIMIT_M:g} m "
-                             f"less than --max-miss ({self.max_miss_m:g} m), got {margin!r}")
+                             f"less than `max_miss_m` ({self.max_miss_m:g} m), got {margin!r}")
         for name in ("launch_bearing_deg", "landing_bearing_deg"):
             value = getattr(self, name)
             if value is not None and not math.isfinite(value):
@@ -202,6 +196,6 @@ def check_altitude_floor(targets: GeoTargets, settings: MissionSettings) -> None
     if len(low):
         raise InputError(
             f"{len(low)} target(s) below the altitude floor of {settings.min_altitude_m:g} m "
-            f"above home (--min-alt), first {targets.label(int(low[0]))} at "
+            f"above home (`min_altitude_m`), first {targets.label(int(low[0]))} at "
             f"{altitudes[low[0]]:g} m; if the site is clear that low, lower the floor "
             "explicitly")

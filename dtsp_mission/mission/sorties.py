@@ -18,7 +18,8 @@ from ..errors import InputError, MissionTooLarge
 from ..frame import LocalFrame
 from ..targets import GeoTargets
 from ..tour import Tour, tour_through_poses
-from .build import build_mission, targets_beyond, with_turn_margin
+from .build import build_mission
+from .widening import targets_beyond, with_turn_margin
 from .settings import MissionSettings
 from .model import Mission
 
@@ -127,7 +128,7 @@ def split_into_sorties(tour: Tour, frame: LocalFrame, targets: GeoTargets,
         # Splitting further is what was just tried: only more room helps.
         raise InputError(f"even {min(MAX_SORTIES, n)} sorties do not fit the vehicle ({limits}): "
                          f"a sortie needs at least {last_error.needed} items but the vehicle holds "
-                         f"{last_error.capacity} (--max-items); allow more if it has the space "
+                         f"{last_error.capacity} (`max_items`); allow more if it has the space "
                          "(ArduPilot with the mission on SD card holds about 4,300)")
     raise InputError(f"even {min(MAX_SORTIES, n)} sorties do not fit the vehicle ({limits}): "
                      f"{last_error}")

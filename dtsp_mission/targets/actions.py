@@ -70,11 +70,11 @@ class TargetActions:
         target has none of its own) and ``loiter_turns`` (target index -> turns) set."""
         pitch = self.gimbal_pitch_deg
         if gimbal_pitch_deg is not None:
-            check_gimbal_pitch(gimbal_pitch_deg, "--gimbal-pitch")
+            check_gimbal_pitch(gimbal_pitch_deg, "`gimbal_pitch_deg`")
             pitch = np.where(np.isnan(pitch), float(gimbal_pitch_deg), pitch)
         turns = self.loiter_turns.copy()
         for index, count in (loiter_turns or {}).items():
-            turns[index] = check_loiter_turns(count, "--loiter")
+            turns[index] = check_loiter_turns(count, "`loiter_turns`")
         return replace(self, photo=self.photo | photo, roi=self.roi | roi, gimbal_pitch_deg=pitch,
                        loiter_turns=turns)
 

@@ -5,6 +5,7 @@ from __future__ import annotations
 import numpy as np
 import shapely
 
+from ..dubins.path import check_radius
 from ..errors import InputError
 from ..frame import LocalFrame
 from .model import GeoTargets, geodetic_targets
@@ -20,6 +21,7 @@ def check_random_area(area_deg: np.ndarray, rho_m: float, where: str) -> None:
     """:class:`InputError` unless the polygon is at least one turn circle (pi rho^2) in area:
     uniform targets in anything smaller measure nothing but the aircraft's turning (and in a
     square centimetre lie closer together than any position fix resolves)."""
+    check_radius(rho_m)
     _, polygon = _local_polygon(area_deg)
     turn = np.pi * rho_m ** 2
     if not polygon.area >= turn:
@@ -34,7 +36,7 @@ def random_targets(area_deg: np.ndarray, count: int, seed: int) -> GeoTargets:
     the polygon ``area_deg`` ((k, 2) rows of latitude, longitude).  The same seed gives the same
     targets."""
     if count < 1:
-        raise InputError(f"random targets: the count (--random) must be at least 1, got {count}")
+        raise InputError(f"random targets: the count (`count`) must be at least 1, got {count}")
     area = np.asarray(area_deg, dtype=float)
     frame, polygon = _local_polygon(area)
     if not polygon.area > 0:

@@ -80,7 +80,7 @@ def vehicle_warnings(mission: VehicleMission, info: VehicleInfo,
             info.autopilot in _AUTOPILOT_NAMES:
         raise LinkError(f"the plan was made for {_autopilot_name(mission.autopilot)}, but the "
                         f"vehicle runs {_autopilot_name(info.autopilot)}: plan again with "
-                        f"--autopilot {'px4' if info.autopilot == Autopilot.PX4 else 'ardupilot'}",
+                        f"`autopilot` {'px4' if info.autopilot == Autopilot.PX4 else 'ardupilot'}",
                         "nothing was sent; the vehicle keeps its mission")
     warnings = []
     if not info.checked:
@@ -97,7 +97,7 @@ def vehicle_warnings(mission: VehicleMission, info: VehicleInfo,
         if abs(speed - ours) > WIND_WARNING_M_S or (max(speed, ours) >= 1.0 and turned > WIND_WARNING_DEG):
             warnings.append(f"the vehicle estimates a wind of {speed:.1f} m/s from {towards:.0f} deg; "
                             f"the mission was designed for {ours:g} m/s from {our_dir:g} deg: it "
-                            "will fly differently than predicted (plan again with --wind)")
+                            "will fly differently than predicted (plan again with `wind` as the vehicle estimates it)")
     if info.home_deg is not None:
         from pyproj import Geod
         _, _, distance = Geod(ellps="WGS84").inv(mission.home.longitude_deg, mission.home.latitude_deg,
@@ -137,7 +137,7 @@ def upload_mission(mission: VehicleMission, connection: str, via: str = "pymavli
     """
     uploader_class = get_uploader(via)
     if signing_key is not None and not uploader_class.supports_signing:
-        raise InputError(f"the {via} uploader cannot sign MAVLink 2 messages; use --via pymavlink")
+        raise InputError(f"the {via} uploader cannot sign MAVLink 2 messages; use `via` pymavlink")
     options = {} if heartbeat_timeout_s is None else {"heartbeat_timeout_s": heartbeat_timeout_s}
     if timeout_s is not None:
         if not timeout_s > 0:
@@ -179,7 +179,7 @@ def upload_mission(mission: VehicleMission, connection: str, via: str = "pymavli
                                     time.perf_counter() - transfer_started)
             what = (describe_vehicle(on_vehicle, wire, mission.autopilot, error.nothing_sent)
                     if verify else
-                    "the vehicle may hold part of this mission (not checked: --no-verify)")
+                    "the vehicle may hold part of this mission (not checked: `verify=False`)")
             raise LinkError(f"upload failed: {error.reason}", what) from None
         if verify:
             try:

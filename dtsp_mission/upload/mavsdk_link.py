@@ -13,7 +13,7 @@ from ..autopilot.wire import WireItem
 #: What each failing MissionRawResult means to the user.
 _RESULTS = {
     "TOO_MANY_MISSION_ITEMS": "the vehicle has no room for this many mission items "
-                              "(MAV_MISSION_NO_SPACE): lower --max-items and plan again",
+                              "(MAV_MISSION_NO_SPACE): lower `max_items` and plan again",
     "TIMEOUT": "the vehicle stopped answering (MAVSDK timed out)",
     "NO_SYSTEM": "the vehicle is gone (no heartbeat)",
     "DENIED": "the vehicle does not accept missions now (MAV_MISSION_DENIED; armed or busy?)",
@@ -45,7 +45,7 @@ class MavsdkUploader(Uploader):
         from mavsdk.plugins.mission_raw import MissionRaw
         if self.signing_key is not None:
             raise LinkError("MAVLink signing is not available through MAVSDK's Python binding; "
-                            "use --via pymavlink with --signing-key")
+                            "use `via` pymavlink with `signing_key`")
         url = mavsdk_url(self.connection)
         quiet_mavsdk_log()
         self._mavsdk = Mavsdk(Configuration.create_with_component_type(ComponentType.GROUND_STATION))

@@ -142,11 +142,11 @@ class PymavlinkUploader(Uploader):
                 return
         if self._unsigned and self._unsigned >= self._bad_signatures:
             raise LinkError(f"the vehicle at {self.connection} answers, but it does not sign its "
-                            "messages: upload without --signing-key, or set up MAVLink 2 signing "
+                            "messages: upload without `signing_key`, or set up MAVLink 2 signing "
                             "on the vehicle with this key first")
         if self._bad_signatures:
             raise LinkError(f"the vehicle at {self.connection} answers, but its messages fail the "
-                            "MAVLink 2 signature check: wrong --signing-key (or the vehicle signs "
+                            "MAVLink 2 signature check: wrong `signing_key` (or the vehicle signs "
                             "with another key)")
         if self.signing_key is not None:
             raise LinkError(f"no signed heartbeat from a vehicle at {self.connection} within "
@@ -159,7 +159,7 @@ class PymavlinkUploader(Uploader):
     def _no_answer(self, what: str) -> LinkError:
         hint = ""
         if getattr(self, "_vehicle_signs", False) and self.signing_key is None:
-            hint = ": the vehicle signs its messages and may ignore unsigned ones; give --signing-key"
+            hint = ": the vehicle signs its messages and may ignore unsigned ones; give `signing_key`"
         return LinkError(f"the vehicle stopped answering ({what}){hint}")
 
     # -- what the vehicle is ---------------------------------------------------------------------
@@ -360,7 +360,7 @@ class PymavlinkUploader(Uploader):
         said = f" (the vehicle said: {' / '.join(self._status_texts)})" if self._status_texts else ""
         if result == NO_SPACE:
             return LinkError(f"the vehicle has no room for {count} mission slots "
-                             f"({result_text(result)}){said}: lower --max-items and plan again",
+                             f"({result_text(result)}){said}: lower `max_items` and plan again",
                              nothing_sent=highest < 0)
         if result in ITEM_RESULTS and highest >= 0:
             item = items[highest]

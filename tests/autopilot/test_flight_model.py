@@ -4,7 +4,6 @@ analytic cases (its agreement with real ArduPlane flights is ``test_agreement.py
 from __future__ import annotations
 
 import math
-from pathlib import Path
 
 import numpy as np
 import pytest
@@ -129,3 +128,30 @@ def test_the_wind_blows_from_where_it_is_said_to():
     assert east == pytest.approx(10.0) and north == pytest.approx(0.0, abs=1e-12)
     east, north = Wind(10.0, 0.0).velocity_m_s         # from the north: towards the south
     assert east == pytest.approx(0.0, abs=1e-12) and north == pytest.approx(-10.0)
+
+
+@pytest.mark.parametrize("airspeed,rho", [(22.0, 80.0), (18.0, 60.0), (25.0, 150.0)])
+def test_the_aircraft_turns_at_the_radius_its_airframe_says(airspeed, rho):
+    """One answer to "what radius does this aircraft turn": asked to loiter on a circle
+    tighter than it can fly, the aircraft made to turn no tighter than ``rho`` turns at its
+    roll limit, on arcs of exactly ``Airframe.turn_radius_m`` at that bank -- which is ``rho``
+    -- measured on the track (distance flown over the course turned, 1 s windows)."""
+    assert Airframe() == Airframe.from_parameters()           # the default is the shipped aircraft
+    airframe = Airframe.turning_at(rho, airspeed)
+    bank = math.radians(airframe.roll_limit_deg)
+    assert airframe.turn_radius_m(airframe.roll_limit_deg) == pytest.approx(
+        airspeed ** 2 / (0.73 * 9.80665 * math.tan(bank)), rel=1e-12)   # 0.73 of the coordinated rate
+    assert airframe.tightest_turn_m == pytest.approx(rho, rel=1e-12)
+    assert airframe.turn_radius_m(airframe.roll_limit_deg) == pytest.approx(rho, rel=1e-12)
+    items = _mission([(400.0, 0.0)], loiter=(1200.0, 0.0, 6.0, 0.3 * rho))
+    flight = MissionFlight(items, airframe, 0.0, 1)
+    run = flight.run(0.02, 3)
+    circling = run.track[run.track[:, 0] > dict(flight.reached)[2] + 30.0]   # in the loiter
+    step = np.diff(circling[:, 1:3], axis=0)
+    course = np.unwrap(np.arctan2(step[:, 1], step[:, 0]))
+    flown = np.concatenate([[0.0], np.cumsum(np.hypot(step[:, 0], step[:, 1]))])
+    window = 50                                                         # 1 s of 0.02 s steps
+    turned = np.maximum(np.abs(course[window:] - course[:-window]), 1e-12)
+    radius = (flown[window:-1] - flown[:-window - 1]) / turned
+    assert radius.min() >= rho * (1 - 1e-3)                             # never tighter
+    assert np.percentile(radius, 25) <= rho * 1.001                     # mostly at the limit

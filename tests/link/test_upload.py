@@ -54,7 +54,7 @@ def test_no_space_names_the_limit_and_nothing_is_claimed(via, mission, start_veh
     with pytest.raises(LinkError) as caught:
         upload_mission(mission, f"udpout:127.0.0.1:{vehicle.port}", via=via)
     message = str(caught.value)
-    assert "no room" in message and "lower --max-items" in message
+    assert "no room" in message and "lower `max_items`" in message
     if via == "pymavlink":     # it relays the vehicle's own words, with the limit
         assert "Only 20 items are supported" in message
     assert "holds no mission" in caught.value.on_vehicle
@@ -158,9 +158,9 @@ def test_signing_right_key_works_wrong_key_is_named(mission, start_vehicle):
     connection = f"udpout:127.0.0.1:{vehicle.port}"
     assert upload_mission(mission, connection, signing_key=key).verified
     assert holds_plan(vehicle, mission)
-    with pytest.raises(LinkError, match="signature check: wrong --signing-key"):
+    with pytest.raises(LinkError, match="signature check: wrong `signing_key`"):
         upload_mission(mission, connection, signing_key=bytes(32), heartbeat_timeout_s=2.0)
-    with pytest.raises(LinkError, match="signs its messages .* give --signing-key"):
+    with pytest.raises(LinkError, match="signs its messages .* give `signing_key`"):
         upload_mission(mission, connection, heartbeat_timeout_s=2.0, timeout_s=3.0)   # unsigned: ignored
     assert holds_plan(vehicle, mission)        # the failed attempts changed nothing aboard
     with pytest.raises(InputError, match="cannot sign"):
@@ -169,7 +169,7 @@ def test_signing_right_key_works_wrong_key_is_named(mission, start_vehicle):
 
 def test_a_key_for_a_vehicle_that_does_not_sign_says_so(mission, start_vehicle):
     vehicle = start_vehicle(mission)                       # no signing on the vehicle
-    with pytest.raises(LinkError, match="does not sign its messages: upload without --signing-key"):
+    with pytest.raises(LinkError, match="does not sign its messages: upload without `signing_key`"):
         upload_mission(mission, f"udpout:127.0.0.1:{vehicle.port}", signing_key=bytes(range(32)),
                        heartbeat_timeout_s=2.0)
     assert holds_nothing(vehicle)
@@ -205,7 +205,7 @@ def test_uploads_over_tcp_a_serial_device_and_udpin(link, mission):
     (udpin) for a vehicle that sends to it first, as an autopilot's UDP output does."""
     from dtsp_mission.autopilot.navigation import Airframe
     from dtsp_mission.sim.vehicle import SimulatedVehicle, VehicleSettings
-    settings = VehicleSettings(mission.home, mission.autopilot, Airframe(20.0, 80.0))
+    settings = VehicleSettings(mission.home, mission.autopilot, Airframe.turning_at(80.0, 20.0))
     if link == "udpin":
         port = free_udp_port()
         vehicle, connection = SimulatedVehicle(settings, gcs=("127.0.0.1", port)), f"udpin:127.0.0.1:{port}"

@@ -31,7 +31,7 @@ def test_a_plan_for_the_other_autopilot_is_refused_before_anything_is_sent(missi
     with pytest.raises(LinkError) as caught:
         upload_mission(mission, f"udpout:127.0.0.1:{vehicle.port}")
     assert "made for ArduPilot, but the vehicle runs PX4" in str(caught.value)
-    assert "--autopilot px4" in str(caught.value)
+    assert "`autopilot` px4" in str(caught.value)
     assert vehicle.uploads == 0 and vehicle.mission == []
 
 
@@ -69,7 +69,7 @@ def test_a_px4_plan_is_refused_by_an_ardupilot_vehicle(start_vehicle):
     with pytest.raises(LinkError) as caught:
         upload_mission(px4, f"udpout:127.0.0.1:{vehicle.port}")
     assert "made for PX4, but the vehicle runs ArduPilot" in str(caught.value)
-    assert "--autopilot ardupilot" in str(caught.value)
+    assert "`autopilot` ardupilot" in str(caught.value)
     assert vehicle.uploads == 0
 
 
@@ -83,7 +83,7 @@ def test_a_vehicle_whose_wind_estimate_differs_from_the_design_wind_is_warned_ab
     assert report.verified
     assert [w for w in report.warnings if "wind" in w] == [
         "the vehicle estimates a wind of 8.0 m/s from 40 deg; the mission was designed for "
-        "0 m/s from 0 deg: it will fly differently than predicted (plan again with --wind)"]
+        "0 m/s from 0 deg: it will fly differently than predicted (plan again with `wind` as the vehicle estimates it)"]
     close = replace(mission, design_wind=(7.0, 55.0))
     assert not [w for w in upload_mission(close, f"udpout:127.0.0.1:{vehicle.port}").warnings
                 if "wind" in w]

@@ -122,7 +122,7 @@ def test_the_loiter_is_flown_the_aircraft_passes_the_target_once_per_circle():
     tour, frame, targets = _site(actions=_every_action(8, {3: 2}))
     mission = build_mission(tour, frame, targets, MissionSettings(
         design="guidance", airspeed_m_s=20.0, loiter_radius_m=90.0))
-    flight = predict_flight(mission.for_vehicle(), Airframe(20.0, RHO_M), dt_s=0.05)
+    flight = predict_flight(mission.for_vehicle(), Airframe.turning_at(RHO_M, 20.0), dt_s=0.05)
     loiter_seq = 1 + next(k for k, item in enumerate(mission.items) if item.role == "loiter")
     assert loiter_seq in flight.reached            # ArduPlane's seq: home is 0
     assert all(1 + k in flight.reached for k in mission.target_items)

@@ -42,7 +42,7 @@ def test_one_waypoint_per_target_and_every_target_predicted_within_the_limit(des
     assert sorted(i.target for i in target_items) == list(range(len(targets)))
     assert len(mission.items) <= 1.4 * len(targets) + 3
     assert max(mission.summary["predicted_miss_m"]) <= 5.0
-    assert not any("beyond --max-miss" in note for note in mission.notes)
+    assert not any("beyond `max_miss_m`" in note for note in mission.notes)
     # the predicted flight is about as long as the exact path over the same span
     assert mission.summary["predicted_flight_m"] == pytest.approx(mission.summary["planned_flight_m"], rel=0.08)
 
@@ -208,7 +208,7 @@ def test_the_turn_margin_keeps_a_design_that_holds_and_otherwise_ranks_by_the_fl
     as it is (no other radius is even planned), however far its flight strays from the plan;
     one that does not is replaced only by a design holding more targets, or as many with a
     shorter predicted flight."""
-    from dtsp_mission.mission.build import targets_beyond, with_turn_margin
+    from dtsp_mission.mission.widening import targets_beyond, with_turn_margin
     tour, frame, targets = _fence(80.0)
     planned = []
 
@@ -238,7 +238,7 @@ def test_the_local_repair_s_other_starts_hold_what_small_steps_cannot():
     limit; given 100 seeded random starts (off by default) it holds every post, and the same
     input gives the same mission.  (The starts are a heuristic, not a guarantee: after six or
     eight rounds they leave two posts beyond where the search alone leaves one or none.)"""
-    from dtsp_mission.mission.build import targets_beyond as beyond
+    from dtsp_mission.mission.widening import targets_beyond as beyond
     tour, frame, targets = _fence(80.0)
     settings = MissionSettings(design="guidance", airspeed_m_s=22.0, altitude_m=120.0,
                                wind_spread_m_s=0.0, tuning=DesignTuning(rounds=4))
@@ -270,7 +270,7 @@ def test_the_local_repair_starts_again_from_the_targets_where_corrections_piled_
     is held.  (A heuristic: over seeds 0-3 at rho 80 and 104 it leaves 14 targets beyond with
     the second search and 14 without.)"""
     from dtsp_mission.api import plan_tour
-    from dtsp_mission.mission.build import targets_beyond
+    from dtsp_mission.mission.widening import targets_beyond
     targets = _clustered(80, 2)
     tour, frame = plan_tour(targets, 80.0)
     settings = MissionSettings(design="guidance", airspeed_m_s=22.0, altitude_m=120.0,

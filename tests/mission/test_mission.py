@@ -14,7 +14,7 @@ from dtsp_mission.mission import Autopilot, Command, Frame
 from dtsp_mission.mission.discretise import deviation_m, waypoint_s
 from dtsp_mission.mission.flight_path import approach
 from dtsp_mission.tour.check import check_path
-from dtsp_mission.vehicle import heading_to_bearing_deg, turn_radius_m
+from dtsp_mission.vehicle import heading_to_bearing_deg
 
 
 def test_enumeration_values_are_mavlinks():
@@ -24,13 +24,6 @@ def test_enumeration_values_are_mavlinks():
         assert getattr(mavlink, f"MAV_FRAME_{frame.name}") == frame.value
     for autopilot in Autopilot:
         assert getattr(mavlink, f"MAV_AUTOPILOT_{autopilot.name}") == autopilot.value
-
-
-def test_turn_radius_from_airspeed_and_bank():
-    assert turn_radius_m(20.0, 45.0) == pytest.approx(400 / 9.80665)
-    assert turn_radius_m(22.0, 30.0) == pytest.approx(484 / (9.80665 * math.tan(math.radians(30))))
-    with pytest.raises(InputError):
-        turn_radius_m(20.0, 90.0)
 
 
 def polyline_distance_m(points: np.ndarray, vertices: np.ndarray) -> np.ndarray:
@@ -114,7 +107,7 @@ def test_item_budget_coarsens_then_refuses_with_the_count_needed():
     assert tight.vehicle_item_count() <= budget
     assert generous.tolerance_m < tight.tolerance_m <= 0.02 * 80
     assert any("coarsened" in note for note in tight.notes)
-    with pytest.raises(InputError, match=r"needs \d+ items .* holds 50 \(--max-items\)"):
+    with pytest.raises(InputError, match=r"needs \d+ items .* holds 50 \(`max_items`\)"):
         make_mission(60, max_items=50)
 
 

@@ -1,0 +1,134 @@
+"""The tour's flight path turned into waypoints: the polyline within a tolerance of the exact
+path (the geometric design, coarsened to fit the vehicle), or the waypoints aimed for the
+autopilot's guidance (:mod:`.guidance`); and the least each needs of the vehicle's storage.
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import replace
+from typing import Callable
+
+import numpy as np
+
+from ..errors import MissionTooLarge
+from ..frame import LocalFrame
+from ..targets import GeoTargets
+from ..tour import Tour
+from ..autopilot.commands import Command
+from ..autopilot.navigation import Airframe
+from ..autopilot.parameters import ARDUPLANE_DEFAULTS
+from .discretise import waypoint_s
+from .guidance import GuidanceDesign, design_waypoints
+from .model import FlightPath
+from .settings import PREFERRED_TOLERANCE_FRACTION, MissionSettings
+
+
+def fixed_items(settings: MissionSettings, actions: int = 0) -> int:
+    """Items that are not waypoints on the path (takeoff, speed, return; ArduPilot's home;
+    the ``actions`` at the targets)."""
+    return (actions + 1 + (settings.airspeed_m_s is not None)
+            + {"rtl": 1, "land": 2, "none": 0}[settings.return_mode]
+            + (settings.autopilot == "ardupilot"))
+
+
+def path_waypoints(path: FlightPath, rho_m: float, tolerance_m: float) -> np.ndarray:
+    """Waypoint arc lengths within ``tolerance_m`` of the path, none on a loiter's circles (a
+    loiter item flies them)."""
+    chosen = waypoint_s(path.chain, rho_m, path.target_s_m, tolerance_m)
+    return chosen[~path.in_loiter(chosen)] if path.loiters else chosen
+
+
+def fit_waypoints(path: FlightPath, rho_m: float, settings: MissionSettings,
+                   actions: int = 0) -> tuple[np.ndarray, float]:
+    """Waypoint arc lengths at the finest tolerance in [preferred, tolerance] that fits the
+    item budget, and that tolerance."""
+    budget = settings.max_items - fixed_items(settings, actions) + 1   # the takeoff point is free
+    fine = PREFERRED_TOLERANCE_FRACTION * settings.tolerance_m
+    chosen = path_waypoints(path, rho_m, fine)
+    if len(chosen) <= budget:
+        return chosen, fine
+    coarse = path_waypoints(path, rho_m, settings.tolerance_m)
+    if len(coarse) > budget:
+        needed = len(coarse) - 1 + fixed_items(settings, actions)
+        raise MissionTooLarge(
+            f"the mission needs {needed} items at a waypoint tolerance of "
+            f"{settings.tolerance_m:.3g} m but the vehicle holds {settings.max_items} "
+            f"(`max_items`). Allow more items if the vehicle has the space (ArduPilot with the "
+            f"mission on SD card, BRD_SD_MISSION, holds about 4,300), accept a coarser "
+            f"`tolerance_m`, or split the targets into several missions", needed, settings.max_items)
+    low, high, chosen = fine, settings.tolerance_m, coarse
+    for _ in range(12):
+        middle = math.sqrt(low * high)
+        attempt = path_waypoints(path, rho_m, middle)
+        if len(attempt) <= budget:
+            high, chosen = middle, attempt
+        else:
+            low = middle
+    return chosen, high
+
+
+def design_for_guidance(path: FlightPath, tour: Tour, frame: LocalFrame, targets: GeoTargets,
+                         settings: MissionSettings, actions: int = 0,
+                         progress: Callable[[int, int], None] | None = None) -> GuidanceDesign:
+    """Waypoints for ArduPlane's guidance (:mod:`.guidance`) within the item budget; the
+    lead-out of a landing stays a geometric polyline."""
+    parameters = settings.vehicle or ARDUPLANE_DEFAULTS
+    airframe = Airframe.from_parameters(parameters, settings.airspeed_m_s)
+    tail = guidance_tail(path, tour, settings, actions)
+    budget = settings.max_items - fixed_items(settings, actions) - len(tail)
+    head = ([(Command.DO_CHANGE_SPEED, (0.0, float(settings.airspeed_m_s), -1.0, 0.0))]
+            if settings.airspeed_m_s is not None else [])
+    altitudes = (np.full(len(tour.targets_m), settings.altitude_m) if targets.altitudes_m is None
+                 else np.asarray(targets.altitudes_m, dtype=float))
+    altitudes = np.where(np.isnan(altitudes), settings.altitude_m, altitudes)   # not given
+    design = design_waypoints(path, tour.targets_m, altitudes, airframe, settings.design_limit_m,
+                              budget, head, settings.target_acceptance_m, progress=progress,
+                              as_stored=lambda points: stored_position_m(frame, points),
+                              winds=settings.design_winds(),
+                              spread_margin_m=settings.max_miss_m - settings.design_limit_m,
+                              tuning=settings.tuning)
+    return replace(design, s_m=np.concatenate([[0.0], design.s_m, tail]),
+                   aim_m=np.vstack([path.chain.pose_at(np.array([0.0]))[:, :2], design.aim_m,
+                                    path.chain.pose_at(tail)[:, :2].reshape(-1, 2)]),
+                   target_of=np.concatenate([[-1], design.target_of, np.full(len(tail), -1)]))
+
+
+def guidance_tail(path: FlightPath, tour: Tour, settings: MissionSettings,
+                   actions: int) -> np.ndarray:
+    """The tail waypoints of a guidance design (:func:`tail_waypoints`), or
+    :class:`MissionTooLarge` if the least it needs -- one waypoint per target, the fixed items,
+    the tail -- does not fit ``settings.max_items``."""
+    tail = tail_waypoints(path, tour.rho_m, settings)
+    fixed = fixed_items(settings, actions)
+    needed = len(tour.targets_m) + fixed + len(tail)
+    if needed > settings.max_items:
+        kinds = ["take-off"] + (["speed"] if settings.airspeed_m_s is not None else [])
+        kinds += {"rtl": ["return"], "land": ["landing"], "none": []}[settings.return_mode]
+        kinds += (["home slot"] if settings.autopilot == "ardupilot" else [])
+        kinds += ([f"{actions} actions"] if actions else [])
+        parts = [f"{len(tour.targets_m)} for the target(s), one each",
+                 f"{fixed} for {', '.join(kinds)}"]
+        if len(tail):
+            parts.append(f"{len(tail)} to the landing approach")
+        raise MissionTooLarge(
+            f"the mission needs at least {needed} items ({', '.join(parts)}) but the vehicle holds "
+            f"{settings.max_items} (`max_items`): allow more if it has the space (ArduPilot with "
+            "the mission on SD card holds about 4,300) or split the targets into several "
+            "missions", needed, settings.max_items)
+    return tail
+
+
+def stored_position_m(frame: LocalFrame, points_m: np.ndarray) -> np.ndarray:
+    """Positions (local frame) moved to where a vehicle stores them: latitude and longitude
+    rounded to MISSION_ITEM_INT's 1e-7 degree (about 1 cm)."""
+    latitudes, longitudes = frame.to_geodetic(np.asarray(points_m, dtype=float).reshape(-1, 2))
+    return frame.to_local(np.round(latitudes * 1e7) / 1e7, np.round(longitudes * 1e7) / 1e7)
+
+
+def tail_waypoints(path: FlightPath, rho_m: float, settings: MissionSettings) -> np.ndarray:
+    """Arc lengths of the waypoints after the last target (the way to a landing approach)."""
+    if settings.return_mode != "land":
+        return np.zeros(0)
+    chosen = waypoint_s(path.chain, rho_m, path.target_s_m, settings.tolerance_m)
+    return chosen[chosen > path.tour_end_s_m + 1e-9]
