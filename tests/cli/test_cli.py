@@ -81,7 +81,7 @@ def test_no_command_module_imports_another():
     """Commands share code through cli.options and cli.runs, never through each other."""
     import ast
     from pathlib import Path
-    folder = Path(__file__).resolve().parents[1] / "dtsp_mission" / "cli"
+    folder = Path(__file__).resolve().parents[2] / "dtsp_mission" / "cli"
     commands = {p.stem for p in folder.glob("*_command.py")}
     for path in folder.glob("*_command.py"):
         for node in ast.walk(ast.parse(path.read_text())):
@@ -98,7 +98,7 @@ def test_the_library_speaks_in_its_own_terms_and_the_cli_in_options():
     import re
     from pathlib import Path
     from dtsp_mission.cli.console import OPTIONS, in_cli_terms
-    package = Path(__file__).resolve().parents[1] / "dtsp_mission"
+    package = Path(__file__).resolve().parents[2] / "dtsp_mission"
     named, flags = set(), []
     for path in package.rglob("*.py"):
         if "cli" in path.relative_to(package).parts or path.parent.name == "bench":

@@ -20,7 +20,7 @@ from dtsp_mission.cli.main import cli
 from dtsp_mission.export import exporter_for
 from dtsp_mission.autopilot.wire import differences, to_wire
 
-SITE = os.path.join(os.path.dirname(__file__), "..", "examples", "site-inspection.csv")
+SITE = os.path.join(os.path.dirname(__file__), "..", "..", "examples", "site-inspection.csv")
 
 
 @pytest.fixture(scope="module")

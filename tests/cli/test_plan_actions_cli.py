@@ -12,7 +12,7 @@ from pymavlink import mavwp
 
 from dtsp_mission.export.qgc_plan import plan_rule_violations
 
-SITE = Path(__file__).parents[1] / "examples" / "site-inspection.csv"
+SITE = Path(__file__).parents[2] / "examples" / "site-inspection.csv"
 
 
 def run(command, *arguments):

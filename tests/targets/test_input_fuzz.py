@@ -26,7 +26,7 @@ from dtsp_mission.export import exporter_for, read_mission
 from dtsp_mission.targets import read_targets
 from dtsp_mission.autopilot.wire import to_wire
 
-ROOT = Path(__file__).resolve().parents[1]
+ROOT = Path(__file__).resolve().parents[2]
 TEXT_VALUES = ["", "nan", "NaN", "inf", "-inf", "1e309", "-1", "0", "999", "-999", "1e-320",
                "true", "null", "x", '"', ",", "\t", " ", "é", "\x00", "1,2", "46.8.1", "0x10"]
 JSON_VALUES = [None, True, False, "x", "", [], {}, [1, 2], float("nan"), float("inf"), -1, 0,

@@ -10,7 +10,7 @@ import pytest
 from conftest import assert_valid_tour
 from dtsp_mission.tour import read_tour
 
-EXAMPLE = Path(__file__).parents[1] / "examples" / "site-local.csv"
+EXAMPLE = Path(__file__).parents[2] / "examples" / "site-local.csv"
 
 
 def run(*arguments):
@@ -119,8 +119,8 @@ def test_duplicates_are_merged_and_reported(tmp_path):
 
 # Defects a new user hit (issue 16): each a clear message and exit 2, or the right file.
 
-SITE = Path(__file__).parents[1] / "examples" / "site-inspection.csv"
-AREA = Path(__file__).parents[1] / "examples" / "survey-area.geojson"
+SITE = Path(__file__).parents[2] / "examples" / "site-inspection.csv"
+AREA = Path(__file__).parents[2] / "examples" / "survey-area.geojson"
 
 
 def test_a_region_that_is_no_number_or_name_is_a_clear_error(tmp_path):

@@ -14,7 +14,7 @@ from conftest import assert_valid_tour
 from dtsp_mission.export.qgc_plan import plan_rule_violations
 from dtsp_mission.tour import read_tour
 
-EXAMPLES = Path(__file__).parents[1] / "examples"
+EXAMPLES = Path(__file__).parents[2] / "examples"
 SITE = EXAMPLES / "site-inspection.csv"
 AREA = EXAMPLES / "survey-area.geojson"
 

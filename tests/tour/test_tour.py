@@ -17,7 +17,7 @@ from dtsp_mission.segments import SegmentChain
 from dtsp_mission.tour import (Tour, check_tour, read_tour, tour_from_dict, tour_through_poses,
                                tour_to_dict, write_tour)
 
-SCHEMA = json.loads((Path(__file__).parents[1] / "dtsp_mission/schemas/tour.schema.json").read_text())
+SCHEMA = json.loads((Path(__file__).parents[2] / "dtsp_mission/schemas/tour.schema.json").read_text())
 
 
 @pytest.fixture
