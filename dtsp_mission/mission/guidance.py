@@ -304,15 +304,23 @@ def _with_shaping(trial: _Trial, targets: list[int], lookback_m: float,
 _POOL: ThreadPoolExecutor | None = None
 
 
+def _cores() -> int:
+    """The cores this process may run on (its affinity: ``taskset``, a container's limit)."""
+    try:
+        return len(os.sched_getaffinity(0))
+    except AttributeError:          # not on Linux
+        return os.cpu_count() or 1
+
+
 def _each(function: Callable, items) -> list:
-    """``[function(item) for item in items]``, on every core (the compiled flights release
-    the GIL); in order, so the result does not depend on the machine."""
+    """``[function(item) for item in items]``, on every core the process may use (the
+    compiled flights release the GIL); in order, so the result does not depend on the machine."""
     global _POOL
     items = list(items)
-    if len(items) < 2 or (os.cpu_count() or 1) < 2:
+    if len(items) < 2 or _cores() < 2:
         return [function(item) for item in items]
     if _POOL is None:
-        _POOL = ThreadPoolExecutor(max_workers=min(os.cpu_count() or 1, 8),
+        _POOL = ThreadPoolExecutor(max_workers=min(_cores(), 8),
                                    thread_name_prefix="design-flights")
     return list(_POOL.map(function, items))
 
@@ -378,12 +386,34 @@ def _refine(aim: np.ndarray, target_of: list[int], items: list[LocalItem], seqs:
             def with_aims(points: np.ndarray) -> MissionArrays:
                 return mission.with_positions(movable_index, points[movable] - home)
 
-            def local_cost(points: np.ndarray) -> float:
-                changed = with_aims(points)
-                worst = _judged(_each(lambda checkpoint: checkpoint.flight.copy(changed).run(
+            def flown(changed: MissionArrays, checkpoint) -> np.ndarray:
+                return checkpoint.flight.copy(changed).run(
                     tuning.verify_step_s, seqs[end], track=False, points_m=local_targets[window],
                     closest_m=checkpoint.closest_m[window], measure_from_seq=_AFTER_TAKEOFF,
-                    until_s=FLIGHT_LIMIT_S).closest_m, checkpoints), spread_margin_m)
+                    until_s=FLIGHT_LIMIT_S).closest_m
+
+            def local_cost(points: np.ndarray, bound: float = math.inf) -> float:
+                """The window's cost with these aims; a trial that cannot beat ``bound`` may
+                be cut short: one wind's misses (the one that weighed most last time) already
+                bound the cost from below (the judged miss is their maximum, less the margin
+                for the winds after the forecast), so the cost returned is then only a value
+                at least ``bound``.  Exact otherwise: the same decisions as flying every wind."""
+                changed = with_aims(points)
+                lead = leading[0]
+                misses: list[np.ndarray | None] = [None] * len(checkpoints)
+                if bound < math.inf and len(checkpoints) > 1:
+                    misses[lead] = flown(changed, checkpoints[lead])
+                    alone = misses[lead] - (spread_margin_m if lead > 0 else 0.0)
+                    low = float(_Trial.cost_of(alone, max_miss_m, tuning.beyond_cost).sum())
+                    if low >= bound:
+                        return low
+                rest = [i for i in range(len(checkpoints)) if misses[i] is None]
+                for i, miss in zip(rest, _each(lambda i: flown(changed, checkpoints[i]), rest)):
+                    misses[i] = miss
+                worst = _judged(misses, spread_margin_m)
+                weights = [_Trial.cost_of(m - (spread_margin_m if i > 0 else 0.0), max_miss_m,
+                                          tuning.beyond_cost).sum() for i, m in enumerate(misses)]
+                leading[0] = int(np.argmax(weights))
                 return float(_Trial.cost_of(worst, max_miss_m, tuning.beyond_cost).sum())
 
             def descend(candidate: np.ndarray, current: float, step_m: float
@@ -399,7 +429,7 @@ def _refine(aim: np.ndarray, target_of: list[int], items: list[LocalItem], seqs:
                                 break
                             moved = candidate.copy()
                             moved[j] = stored((moved[j] + step_m * np.asarray(direction))[None])[0]
-                            c = local_cost(moved)
+                            c = local_cost(moved, best_cost)
                             trials += 1
                             if c < best_cost:
                                 best_move, best_cost = moved, c
@@ -410,6 +440,7 @@ def _refine(aim: np.ndarray, target_of: list[int], items: list[LocalItem], seqs:
                 return candidate, current
 
             first_step_m = max(min(miss[t] - max_miss_m, 10.0), 1.0)
+            leading = [0]           # the wind whose misses weighed most in the last full trial
             initial = local_cost(aim)
             candidate, current = descend(aim.copy(), initial, first_step_m)
             if current > 0.0 and tuning.local_reset:
@@ -429,7 +460,7 @@ def _refine(aim: np.ndarray, target_of: list[int], items: list[LocalItem], seqs:
                     moved = aim.copy()
                     moved[movable] = stored(aim[movable] + rng.uniform(
                         -tuning.local_spread_m, tuning.local_spread_m, (len(movable), 2)))
-                    c = local_cost(moved)
+                    c = local_cost(moved, best_cost)
                     if c < best_cost:
                         best_start, best_cost = moved, c
                         if c <= 0.0:
