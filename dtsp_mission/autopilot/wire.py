@@ -13,8 +13,8 @@ from __future__ import annotations
 from dataclasses import fields
 
 from .storage import MISSION_TYPE_MISSION, WireItem, comparable
-from ..mission import Autopilot, Command, Frame, VehicleMission, degrees_to_e7
-from ..mission.model import Home, MissionItem
+from .commands import Autopilot, Command, Frame
+from .mission import Home, MissionItem, VehicleMission, degrees_to_e7
 
 
 #: Fields compared between plan and vehicle (``current`` is state, not content).

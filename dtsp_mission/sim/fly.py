@@ -20,7 +20,8 @@ from pymavlink import mavutil
 from ..errors import InputError, LinkError
 from ..frame import LocalFrame
 from ..targets.model import target_name
-from ..mission import Command, VehicleMission
+from ..autopilot.commands import Command
+from ..autopilot.mission import VehicleMission
 from ..upload import UploadReport, upload_mission
 from ..upload.pymavlink_link import GCS_COMPONENT_ID, GCS_SYSTEM_ID, use_mavlink2
 from ..autopilot.navigation import CALM, Airframe, Wind, closest_approach_m

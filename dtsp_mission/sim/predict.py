@@ -16,7 +16,7 @@ from ..autopilot import Command, stored_item
 from ..autopilot.navigation import (CALM, FLIGHT_LIMIT_S, MODEL_STEP_S, Airframe, LocalItem,
                                     MissionFlight, Wind, launch_heading_rad, local_items)
 from ..frame import LocalFrame
-from ..mission import VehicleMission
+from ..autopilot.mission import VehicleMission
 from ..autopilot.wire import first_mission_seq, to_wire
 
 _FLOWN = (Command.NAV_WAYPOINT, Command.NAV_LOITER_TURNS, Command.NAV_LOITER_TIME)

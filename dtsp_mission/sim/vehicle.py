@@ -40,8 +40,8 @@ from ..autopilot.parameters import ARDUPLANE_DEFAULTS, NAMES, VehicleParameters,
 from ..autopilot.storage import MissionStore, stored_item
 from ..frame import LocalFrame
 from ..mavsdk_log import quiet_mavsdk_log
-from ..mission import Autopilot
-from ..mission.model import Home, degrees_to_e7
+from ..autopilot.commands import Autopilot
+from ..autopilot.mission import Home, degrees_to_e7
 from ..autopilot.wire import WireItem, first_mission_seq, home_placeholder
 from .mission_server import MissionServer
 from .transport import Transport, UdpTransport, open_transport

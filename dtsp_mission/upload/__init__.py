@@ -15,7 +15,8 @@ from dataclasses import dataclass, replace
 from ..autopilot import MAVLINK_MAX_ITEMS, Autopilot
 from ..autopilot.parameters import ARDUPLANE_DEFAULTS, NAMES, VehicleParameters, parameters_from
 from ..errors import InputError, LinkError
-from ..mission import Command, VehicleMission
+from ..autopilot.commands import Command
+from ..autopilot.mission import VehicleMission
 from ..plugins import load_group, working
 from .base import VEHICLE_GIVES_UP_S, Progress, Uploader, VehicleInfo
 from ..autopilot.wire import WireItem, describe_vehicle, differences, to_wire

@@ -21,7 +21,7 @@ from pymavlink.dialects.v20.common import (MAV_AUTOPILOT_ARDUPILOTMEGA, MAV_AUTO
 
 from ..autopilot.parameters import parameter_name
 from ..errors import LinkError
-from ..mission import Command
+from ..autopilot.commands import Command
 from .connection import check_host
 from .base import (MIN_TIMEOUT_S, TIMEOUT_S, VEHICLE_GIVES_UP_S, Progress, Uploader, VehicleInfo,
                    transfer_timeout_s)

@@ -1,6 +1,10 @@
-"""Missions designed for the autopilot's guidance: one aimed waypoint per target, checked by
-flying the written mission again, independently, through the simulated vehicle's own path
-(storage, geodetic round trip, the flight model)."""
+"""Missions designed for the autopilot's guidance: one aimed waypoint per target.
+
+These tests check the design against the flight model it was made with: that what the design
+reports is what the written mission flies (through the vehicle's storage and the geodetic
+round trip, from the start), and that its repairs hold more targets.  They are not evidence
+that a real aircraft passes the targets: the model's agreement with real ArduPlane flights is
+``tests/autopilot/test_agreement.py``, and its margin comes from those flights."""
 
 from __future__ import annotations
 

@@ -252,3 +252,16 @@ def test_a_serial_device_that_does_not_exist_is_one_clear_error():
     with pytest.raises(LinkError, match="cannot open the connection '/dev/ttyNOSUCH0,57600'"):
         upload_mission(make_mission(3, 1, 80.0, span_m=500.0).for_vehicle(),
                        "/dev/ttyNOSUCH0,57600", heartbeat_timeout_s=0.5)
+
+
+def test_the_uploader_and_the_simulated_vehicle_need_nothing_of_the_designer():
+    """What a vehicle receives lives below the mission design (autopilot.mission): importing
+    the uploader or the simulated vehicle loads no planner, designer or exporter."""
+    import subprocess
+    import sys
+    code = ("import sys, dtsp_mission.upload, dtsp_mission.sim.vehicle, dtsp_mission.sim.fly; "
+            "print(sorted(m for m in sys.modules if m.startswith(('dtsp_mission.mission', "
+            "'dtsp_mission.planning', 'dtsp_mission.export', 'dtsp_mission.pipeline'))))")
+    loaded = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True,
+                            timeout=120, check=True).stdout.strip()
+    assert loaded == "[]"

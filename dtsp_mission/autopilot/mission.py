@@ -1,0 +1,117 @@
+"""What a vehicle receives: mission items in plain units, the home they are relative to, the
+autopilot flavour -- the form files are read into and uploaders and the simulated vehicle
+take.  Below the mission design (importing it needs nothing of the planner or the designer).
+
+Coordinates are exact degrees (float64); a format that needs integers (MISSION_ITEM_INT)
+rounds them with :func:`degrees_to_e7` -- in one place.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+from .commands import Autopilot, Command, Frame
+
+
+def degrees_to_e7(degrees: float) -> int:
+    """Degrees as the int32 of MISSION_ITEM_INT (``round(deg * 1e7)``, about 1 cm)."""
+    return int(round(degrees * 1e7))
+
+
+@dataclass(frozen=True)
+class MissionItem:
+    """One mission item, as MISSION_ITEM_INT carries it, in plain units.
+
+    ``params`` are param1..param4; for items without a position (frame MISSION)
+    ``latitude_deg``/``longitude_deg`` carry param5/param6 as plain numbers (MISSION_ITEM_INT's
+    x and y unscaled, as ArduPilot and QGroundControl read them: DO_DIGICAM_CONTROL's shutter
+    flag), 0 for most.  ``altitude_m`` is relative to home in frame GLOBAL_RELATIVE_ALT.
+    ``role`` says why the item is there (takeoff, speed, path, target, land_start, approach,
+    land, return) and ``target`` which target (input order) a ``target`` item visits.
+    """
+
+    command: int
+    frame: int
+    params: tuple[float, float, float, float]
+    latitude_deg: float = 0.0
+    longitude_deg: float = 0.0
+    altitude_m: float = 0.0
+    autocontinue: bool = True
+    role: str = "path"
+    target: int = -1
+
+    @property
+    def has_position(self) -> bool:
+        return self.frame != Frame.MISSION
+
+
+@dataclass(frozen=True)
+class Home:
+    """Launch (home) position; ``altitude_amsl_m`` is above mean sea level."""
+
+    latitude_deg: float
+    longitude_deg: float
+    altitude_amsl_m: float = 0.0
+
+
+_POSITIONLESS_FRAMES = {2}      # MAV_FRAME_MISSION: x and y are parameters, not a position
+#: Frames whose altitude is above home or above the terrain (GLOBAL_RELATIVE_ALT, _INT,
+#: GLOBAL_TERRAIN_ALT, _INT): a navigation item there below 0 flies into the ground.
+_ABOVE_HOME_FRAMES = {3, 6, 10, 11}
+
+
+_FLOAT32_MAX = 3.4028234663852886e38
+
+
+@dataclass(frozen=True)
+class VehicleMission:
+    """What a vehicle receives: the items, the home they are relative to, and the autopilot
+    flavour (ArduPilot keeps home at seq 0, PX4 does not).  Files read back and planned
+    missions both give this, so uploaders and the simulator need nothing else.
+
+    ``autopilot_stated`` is False for a file format that does not say the autopilot (QGC WPL
+    110): ``autopilot`` is then ArduPilot's, the format's origin, and an uploader takes the
+    vehicle's instead."""
+
+    items: tuple[MissionItem, ...]
+    home: Home
+    autopilot: Autopilot
+    autopilot_stated: bool = True
+    #: the wind the mission was designed for: (m/s, degrees true it comes from); None: unknown
+    design_wind: tuple[float, float] | None = None
+    #: what the file holds beside the mission items, which an upload of the items does not
+    #: carry ("a geofence of 1 polygon", "1 rally point")
+    not_carried: tuple[str, ...] = ()
+
+    def problems(self) -> list[str]:
+        """What no autopilot would take, or no operator would fly, from this mission: a home or
+        an item position off the globe (MAVLink's int32 degrees x 1e7 cannot even carry it) or
+        not a number; a navigation item (other than a landing) below home or the terrain; a
+        command, frame or value that MISSION_ITEM_INT cannot carry (command 16 bits, frame 8,
+        parameters and altitude 32-bit floats)."""
+        found = []
+        for number, item in enumerate(self.items, start=1):
+            values = (*item.params, item.altitude_m)
+            if not (0 <= int(item.command) <= 0xFFFF and 0 <= int(item.frame) <= 0xFF):
+                found.append(f"item {number}: command {int(item.command)} / frame "
+                             f"{int(item.frame)} is not a MAVLink command / frame number")
+            elif any(abs(v) > _FLOAT32_MAX for v in values):      # NaN passes: PX4's "unset"
+                found.append(f"item {number} (command {int(item.command)}): a parameter or the "
+                             "altitude is beyond what MAVLink carries (32-bit floats, "
+                             f"at most {_FLOAT32_MAX:.3g})")
+        if not (-90 <= self.home.latitude_deg <= 90 and -180 <= self.home.longitude_deg <= 180):
+            found.append(f"home ({self.home.latitude_deg:g}, {self.home.longitude_deg:g}) is not "
+                         "a latitude and longitude in degrees")
+        for number, item in enumerate(self.items, start=1):
+            if int(item.frame) in _POSITIONLESS_FRAMES:
+                continue
+            if not (-90 <= item.latitude_deg <= 90 and -180 <= item.longitude_deg <= 180):
+                found.append(f"item {number} (command {int(item.command)}) is at latitude "
+                             f"{item.latitude_deg:g}, longitude {item.longitude_deg:g}: not a "
+                             "position in degrees")
+            elif (int(item.frame) in _ABOVE_HOME_FRAMES and int(item.command) < 100
+                  and int(item.command) != Command.NAV_LAND
+                  and not (item.altitude_m >= 0)):       # NaN too
+                found.append(f"item {number} (command {int(item.command)}) is {item.altitude_m:g} m "
+                             "above home: below the ground the aircraft took off from")
+        return found
