@@ -6,7 +6,10 @@ _installed = False
 
 
 def quiet_mavsdk_log() -> None:
-    """Show only MAVSDK's errors, except the send failures of a link being torn down."""
+    """Show only MAVSDK's errors, except the send failures of a link being torn down.
+
+    Subscribes once per process, before the first MAVSDK instance: MAVSDK's threads may be
+    logging through the callback, and replacing it under them frees what they call."""
     global _installed
     if _installed:
         return

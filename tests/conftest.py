@@ -75,10 +75,12 @@ def mavsdk_mission_raw():
     MAVSDK autopilot component: the real importers (QGC .plan, Mission Planner text) need a
     system, and this is the smallest real one."""
     from mavsdk import ComponentType, Configuration, Mavsdk
-    from mavsdk.logging import LogLevel, log_subscribe
     from mavsdk.plugins.mission_raw import MissionRaw
+    from dtsp_mission.mavsdk_log import quiet_mavsdk_log
 
-    log_subscribe(lambda level, message, file, line: level < LogLevel.ERROR)
+    # Once per process, before any MAVSDK instance runs: subscribing again while MAVSDK's
+    # threads log frees the callback they are calling (a segfault seen in a test run).
+    quiet_mavsdk_log()
     port = free_udp_port()
     ground = Mavsdk(Configuration.create_with_component_type(ComponentType.GROUND_STATION))
     ground.add_any_connection(f"udpin://127.0.0.1:{port}")

@@ -332,9 +332,11 @@ def _report_sorties(result: PlanResult, max_miss_m: float) -> None:
         time_text = (f", {_duration(summary['flight_time_s'])}" if "flight_time_s" in summary
                      else "")
         beyond = targets_beyond(sortie.mission)
+        again = sortie.mission.guidance.revisit_waypoints if sortie.mission.guidance else 0
         say(f"  sortie {k + 1}: {len(sortie.targets)} targets ({label(first)} .. "
             f"{label(last)}), {summary['items']} items, "
             f"{summary['flight_length_m'] / 1e3:,.2f} km{time_text}"
+            + (f", {again} passing a target again" if again else "")
             + (f", {beyond} predicted beyond the design limit" if beyond else ""))
 
 
@@ -396,7 +398,8 @@ def _report_mission(mission) -> None:
     if guidance is not None:
         misses = guidance.predicted_miss_m
         say(f"mission ({flavour}): {summary['items']} items ({summary['items'] / len(misses):.2f} "
-            f"per target, {guidance.shaping_waypoints} shaping waypoints), "
+            f"per target, {guidance.shaping_waypoints} shaping waypoints"
+            f"{f', {guidance.revisit_waypoints} passing a target again' if guidance.revisit_waypoints else ''}), "
             f"{summary['vehicle_slots']} vehicle slots; designed for the autopilot's "
             f"guidance: targets passed within median {np.median(misses):.1f} m, max "
             f"{misses.max():.1f} m in the flight model, {_wind_text(guidance.design_wind)}")

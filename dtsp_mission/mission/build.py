@@ -184,7 +184,8 @@ def build_mission(tour: Tour, frame: LocalFrame, targets: GeoTargets,
             settings.design_limit_m, design.predicted_length_m, design.planned_length_m,
             sum(i.role == "shaping" for i in items), design.rounds,
             (settings.wind.speed_m_s, settings.wind.from_deg), settings.wind_spread_m_s,
-            tuple((w.speed_m_s, w.from_deg) for w in settings.design_winds()))
+            tuple((w.speed_m_s, w.from_deg) for w in settings.design_winds()),
+            sum(i.role == "revisit" for i in items))
         summary.update(guidance.as_summary())
     autopilot = AUTOPILOTS[settings.autopilot]
     mission = Mission(tuple(items), Home(home_lat, home_lon, settings.home_altitude_amsl_m),

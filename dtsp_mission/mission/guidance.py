@@ -35,7 +35,14 @@ checked against recorded ArduPlane flights) and repairing what it misses:
    targets put back on their targets (``local_reset``), and from the best of ``local_starts``
    random placements of them within ``local_spread_m`` (none by default); the change is kept only if the mission flown
    on from the checkpoint costs less.  Up to ``refine_passes`` passes, each ending with the whole mission flown afresh;
-   the design returned is the best of those fresh flights.
+   the design returned is the best of those fresh flights;
+8. with ``revisits`` (the wider-turn stage asks for them when its best design still leaves
+   targets beyond): each target still beyond is passed a second time later in the mission --
+   a waypoint over it (its altitude, its acceptance radius) where it lengthens the straight
+   legs least, at least ``revisit_apart`` waypoints from its own -- and the local repair runs
+   again (a revisit's waypoint is moved for its target like the target's own); up to
+   ``revisit_rounds`` rounds, each kept only if the robust cost falls.  A target's miss is the
+   closest of its passes.
 
 The rounds 2-5 (at the coarser ``prediction_step_s``) hold the targets within ``max_miss_m -
 PREDICTION_MARGIN_M``; the verifying flight and the local repair within ``max_miss_m -
@@ -141,6 +148,17 @@ class DesignTuning:
     #: The wider turn radii (times the one asked for) the whole tour is planned again with,
     #: in turn, when the design at the radius asked for does not hold every target.
     guidance_margins: tuple[float, ...] = (1.3, 1.6)
+    #: Targets the local repair leaves beyond are passed again later in the mission: one
+    #: waypoint over each (its own acceptance radius), inserted where it lengthens the flight
+    #: least (the straight-line detour, plus ``revisit_turn_m`` per radian turned at it), at
+    #: least ``revisit_apart`` waypoints from the target's own; then the local repair once more.
+    revisits: bool = False
+    #: ... and the wider turns (:func:`~dtsp_mission.mission.widening.with_turn_margin`) end
+    #: with the best design made again with revisits when it still leaves targets beyond.
+    revisit_last: bool = True
+    revisit_turn_m: float = 80.0
+    revisit_apart: int = 4
+    revisit_rounds: int = 3
 
 
 def _shaping_gap(s_wp: list[float], k: int, lookback_m: float,
@@ -210,6 +228,24 @@ def _nearest_in(track_xy: np.ndarray, point: np.ndarray) -> np.ndarray:
     return q[int(np.argmin(((q - point) ** 2).sum(axis=1)))]
 
 
+#: ``target_of`` of a revisit of target t: ``REVISIT - t`` (plain shaping waypoints are -1).
+REVISIT = -2
+
+
+def revisited(marker: int) -> int:
+    """The target a waypoint's ``target_of`` marks as revisited, or -1."""
+    return REVISIT - marker if marker <= REVISIT else -1
+
+
+def waypoint_altitudes_m(path: FlightPath, s_wp, target_of) -> np.ndarray:
+    """Each waypoint's altitude: the path's where it stands, a revisit's its target's."""
+    altitudes = path.altitude_m(np.asarray(s_wp, dtype=float))
+    for k, marker in enumerate(target_of):
+        if revisited(int(marker)) >= 0:
+            altitudes[k] = path.altitude_m(np.array([path.target_s_m[revisited(int(marker))]]))[0]
+    return altitudes
+
+
 def _local_items(takeoff_m: np.ndarray, takeoff_alt_m: float, head_items, aim_m: np.ndarray,
                  altitudes_m: np.ndarray, target_of: list[int], target_acceptance_m: float,
                  loiters: dict[int, tuple[float, float, tuple]] | None = None
@@ -227,7 +263,8 @@ def _local_items(takeoff_m: np.ndarray, takeoff_alt_m: float, head_items, aim_m:
         seqs.append(len(items))
         items.append(LocalItem(len(items), Command.NAV_WAYPOINT, float(point[0]), float(point[1]),
                                float(altitude),
-                               (0.0, target_acceptance_m if t >= 0 else 0.0, 0.0, 0.0)))
+                               (0.0, target_acceptance_m if t >= 0 or t <= REVISIT else 0.0,
+                                0.0, 0.0)))
         if loiters and t in loiters:
             x, y, params = loiters[t]
             items.append(LocalItem(len(items), Command.NAV_LOITER_TURNS, x, y, float(altitude),
@@ -374,12 +411,14 @@ def _refine(aim: np.ndarray, target_of: list[int], items: list[LocalItem], seqs:
         before_pass = cost.sum()
         if before_pass <= 0.0:
             break
-        for k, t in enumerate(target_of):
+        for k, marker in enumerate(target_of):
+            t = marker if marker >= 0 else revisited(marker)      # a revisit repairs its target
             if t < 0 or cost[t] <= 0.0:
                 continue
             begin, end = max(k - tuning.local_back, 0), min(k + tuning.local_ahead, len(seqs) - 1)
             checkpoints = marks[seqs[begin]]
-            window = [target_of[j] for j in range(begin, end + 1) if target_of[j] >= 0]
+            window = [u for u in dict.fromkeys(m if m >= 0 else revisited(m)
+                                               for m in target_of[begin:end + 1]) if u >= 0]
             movable = list(range(max(k - tuning.local_move, begin + 1 if begin > 0 else 0), k + 1))
             movable_index = np.array([seqs[j] for j in movable], dtype=np.int64)
 
@@ -494,6 +533,38 @@ def _refine(aim: np.ndarray, target_of: list[int], items: list[LocalItem], seqs:
         if cost.sum() < best[3]:
             best = (aim, miss, length, cost.sum())
     return best[0], best[1], best[2], flights
+
+
+def _with_revisits(s_wp: list[float], target_of: list[int], aim: np.ndarray,
+                   targets_m: np.ndarray, beyond: list[int], tuning: DesignTuning,
+                   end_s_m: float = math.inf) -> tuple[list[float], list[int], np.ndarray]:
+    """The waypoints with one more over each of ``beyond``, each where it lengthens the
+    straight legs least (turns at it weighed by ``revisit_turn_m`` per radian), at least
+    ``revisit_apart`` waypoints from the target's own."""
+    s_wp, target_of, points = list(s_wp), list(target_of), [p for p in np.asarray(aim)]
+    for t in beyond:
+        own = target_of.index(t)
+        here = np.asarray(targets_m[t], dtype=float)
+        best, best_cost = None, math.inf
+        for k in range(len(points) - 1):
+            if (abs(k - own) < tuning.revisit_apart or abs(k + 1 - own) < tuning.revisit_apart
+                    or s_wp[k] >= end_s_m - 1e-9):
+                continue
+            a, b = points[k], points[k + 1]
+            into, out = here - a, b - here
+            la, lb = float(np.hypot(*into)), float(np.hypot(*out))
+            if la < 1e-6 or lb < 1e-6:
+                continue
+            turn = abs(math.atan2(into[0] * out[1] - into[1] * out[0], float(into @ out)))
+            cost = la + lb - float(np.hypot(*(b - a))) + tuning.revisit_turn_m * turn
+            if cost < best_cost:
+                best, best_cost = k, cost
+        if best is None:
+            continue
+        s_wp.insert(best + 1, s_wp[best])
+        target_of.insert(best + 1, REVISIT - t)
+        points.insert(best + 1, here)
+    return s_wp, target_of, np.array(points)
 
 
 def design_waypoints(path: FlightPath, targets_m: np.ndarray, altitudes_m: np.ndarray,
@@ -627,15 +698,34 @@ def design_waypoints(path: FlightPath, targets_m: np.ndarray, altitudes_m: np.nd
                                        targets_m, verify_miss_m, airframe, heading, stored, winds,
                                        spread_margin_m, tuning)
     flights += flown
+    s_final, target_final = design.s_m, list(best.target_of)
+    for _ in range(tuning.revisit_rounds if tuning.revisits else 0):
+        beyond = [int(t) for t in np.flatnonzero(miss > verify_miss_m)]
+        room = budget - len(target_final)
+        if not beyond or room <= 0:
+            break
+        s_new, target_new, aim_new = _with_revisits(list(s_final), list(target_final), aim,
+                                                    targets_m, beyond[:room], tuning,
+                                                    path.tour_end_s_m)
+        items, seqs = _local_items(takeoff, takeoff_alt, head_items, aim_new - home,
+                                   waypoint_altitudes_m(path, s_new, target_new), target_new,
+                                   target_acceptance_m, loiters)
+        aim2, miss2, length2, flown2 = _refine(aim_new, target_new, items, seqs, home, targets_m,
+                                               verify_miss_m, airframe, heading, stored, winds,
+                                               spread_margin_m, tuning)
+        flights += flown2
+        if not (_Trial.cost_of(miss2, verify_miss_m).sum() < _Trial.cost_of(miss, verify_miss_m).sum()):
+            break
+        s_final, target_final, aim, miss, length = np.asarray(s_new), target_new, aim2, miss2, length2
     if progress is not None:
         progress(min(flights, rounds), rounds)
     final, _ = _local_items(takeoff, takeoff_alt, head_items, aim - home,
-                            path.altitude_m(design.s_m), best.target_of, target_acceptance_m,
-                            loiters)
+                            waypoint_altitudes_m(path, s_final, target_final), target_final,
+                            target_acceptance_m, loiters)
     misses = [run.closest_m for run in _each(
         lambda wind: MissionFlight(final, airframe, heading, 1, wind).run(
             tuning.verify_step_s, len(final) - 2, points_m=targets_m - home, track=False,
             measure_from_seq=_AFTER_TAKEOFF, until_s=FLIGHT_LIMIT_S), winds)]
-    return GuidanceDesign(design.s_m, aim, design.target_of, misses[0], length + skipped_m,
+    return GuidanceDesign(np.asarray(s_final), aim, np.asarray(target_final), misses[0], length + skipped_m,
                           design.planned_length_m, flights + len(winds),
                           _judged(misses, spread_margin_m), np.max(misses, axis=0))

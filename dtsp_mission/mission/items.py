@@ -8,7 +8,7 @@ import numpy as np
 from ..frame import LocalFrame
 from ..targets import GeoTargets
 from ..autopilot.commands import Command, Frame
-from .guidance import GuidanceDesign
+from .guidance import GuidanceDesign, revisited, waypoint_altitudes_m
 from .model import FlightPath, MissionItem, waypoint
 from .settings import MissionSettings
 
@@ -20,7 +20,8 @@ def mission_items(path: FlightPath, chosen: np.ndarray, frame: LocalFrame, targe
     autopilot must be sent to pass over them) and its shaping waypoints are plain waypoints."""
     points = path.chain.pose_at(chosen)[:, :2] if design is None else design.aim_m
     latitudes, longitudes = frame.to_geodetic(points)
-    altitudes = path.altitude_m(chosen)
+    altitudes = (path.altitude_m(chosen) if design is None
+                 else waypoint_altitudes_m(path, chosen, design.target_of))
     if design is None:
         target_at = {float(s): index for index, s in enumerate(path.target_s_m)}
     else:
@@ -41,6 +42,9 @@ def mission_items(path: FlightPath, chosen: np.ndarray, frame: LocalFrame, targe
             index = target_at[s]
             items.append(waypoint(targets.latitudes_deg[index], targets.longitudes_deg[index],
                                   altitudes[k], "target", index, settings.target_acceptance_m))
+        elif design is not None and revisited(int(design.target_of[k])) >= 0:
+            items.append(waypoint(latitudes[k], longitudes[k], altitudes[k], "revisit",
+                                  revisited(int(design.target_of[k])), settings.target_acceptance_m))
         elif design is not None and s <= path.tour_end_s_m:
             items.append(waypoint(latitudes[k], longitudes[k], altitudes[k], "shaping"))
         elif settings.return_mode == "land" and k == len(chosen) - 1:

@@ -71,7 +71,7 @@ class GuidancePrediction:
     design is judged by (the forecast's, or the worst of the others less the model's margin,
     whichever is further beyond its limit: held when at most ``design_limit_m``).  The
     predicted flight and the planned one over the same span, the shaping waypoints added, the
-    predicted flights made, the forecast wind (speed m/s, from deg) with its spread (m/s) and
+    predicted flights made, the waypoints passing a target a second time, the forecast wind (speed m/s, from deg) with its spread (m/s) and
     the winds flown.
     """
 
@@ -86,6 +86,7 @@ class GuidancePrediction:
     design_wind: tuple[float, float]
     wind_spread_m_s: float
     design_winds: tuple[tuple[float, float], ...]
+    revisit_waypoints: int = 0
 
     def targets_beyond(self, limit_m: float | None = None) -> int:
         """Targets not held: judged beyond the design limit; with ``limit_m``, predicted
@@ -103,6 +104,7 @@ class GuidancePrediction:
                 "predicted_flight_m": self.predicted_flight_m,
                 "planned_flight_m": self.planned_flight_m,
                 "shaping_waypoints": self.shaping_waypoints, "design_rounds": self.design_rounds,
+                "revisit_waypoints": self.revisit_waypoints,
                 "design_wind": {"speed_m_s": speed, "from_deg": from_deg,
                                 "spread_m_s": self.wind_spread_m_s},
                 "design_winds": [list(w) for w in self.design_winds],

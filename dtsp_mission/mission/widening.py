@@ -3,6 +3,7 @@ or of a tour planned with a wider radius when that holds more targets or flies s
 
 from __future__ import annotations
 
+from dataclasses import replace
 from typing import Callable
 
 from ..errors import DtspError
@@ -44,6 +45,16 @@ def with_turn_margin(mission: Mission, replan: Callable[[float], Tour], targets:
                                       settings, None if progress is None else progress(index + 1))
         except DtspError:
             continue
+        if key(candidate) < key(best):
+            best = candidate
+    if key(best)[0] > 0 and settings.tuning.revisit_last and not settings.tuning.revisits:
+        # Still targets beyond: the best design again, those targets passed a second time.
+        again = replace(settings, tuning=replace(settings.tuning, revisits=True))
+        try:
+            candidate = build_mission(best.tour, best.frame, targets, again, None if progress is
+                                      None else progress(len(settings.tuning.guidance_margins) + 1))
+        except DtspError:
+            candidate = best
         if key(candidate) < key(best):
             best = candidate
     return best

@@ -314,3 +314,41 @@ def test_a_mission_designed_for_the_wind_holds_in_it_what_a_calm_design_misses()
     # what the design reports is what the model flies in that wind
     assert np.abs(np.array(windy.summary["predicted_miss_m"]) - in_wind_designed).max() < 0.01
     assert windy.summary["design_wind"]["speed_m_s"] == 8.0
+
+
+@pytest.mark.heavy(seconds=40)
+def test_a_target_left_beyond_is_passed_again_later_and_held():
+    """On the clustered site of the test above, without the second search the design leaves a
+    target beyond its limit; with revisits each such target is passed a second time later in
+    the mission -- one waypoint over it, at its altitude and acceptance radius -- which brings
+    it closer (here not within the limit: revisits are a heuristic, kept only when the robust
+    cost falls), and the written mission, flown again from the start, passes the targets as
+    the design reports."""
+    from dtsp_mission.api import plan_tour
+    from dtsp_mission.mission.widening import targets_beyond as beyond
+    from dtsp_mission.sim.fly import planned_targets
+    targets = _clustered(80, 2)
+    tour, frame = plan_tour(targets, 80.0)
+    settings = MissionSettings(design="guidance", airspeed_m_s=22.0, altitude_m=120.0,
+                               home_deg=CENTRE, wind_spread_m_s=0.0)
+    alone = build_mission(tour, frame, targets, replace(
+        settings, tuning=DesignTuning(local_reset=False)))
+    again = build_mission(tour, frame, targets, replace(
+        settings, tuning=DesignTuning(local_reset=False, revisits=True)))
+    assert beyond(alone) > 0 and beyond(again) <= beyond(alone)
+    limit = settings.checked(80.0).design_limit_m
+    excess = [np.maximum(m.guidance.judged_miss_m - limit, 0.0).sum() for m in (alone, again)]
+    assert excess[1] < excess[0]
+    revisits = [item for item in again.items if item.role == "revisit"]
+    assert revisits and again.guidance.revisit_waypoints == len(revisits)
+    own = {item.target: item for item in again.items if item.role == "target"}
+    latitudes, longitudes = again.target_positions_deg
+    for item in revisits:
+        assert item.params[1] == own[item.target].params[1] > 0          # its acceptance radius
+        assert item.altitude_m == pytest.approx(own[item.target].altitude_m)
+    flown = predict_flight(again.for_vehicle(), Airframe.from_parameters(airspeed_m_s=22.0))
+    passed = planned_targets(again)
+    miss = closest_approach_m(flown.track[:, 1:3],
+                              flown.frame.to_local(passed.latitudes_deg, passed.longitudes_deg))
+    order = [item.target for item in again.items if item.role == "target"]
+    assert np.abs(miss - again.guidance.predicted_miss_m[order]).max() < 0.3
