@@ -265,22 +265,30 @@ def _clustered(count: int, seed: int):
     return local_targets(points).to_geodetic(LocalFrame(*CENTRE))
 
 
-@pytest.mark.heavy(seconds=60)
-def test_the_local_repair_starts_again_from_the_targets_where_corrections_piled_up():
-    """On a clustered site (80 targets, seed 2, rho 80 m; forecast wind only) the pattern
-    search from the repaired aims leaves a target beyond the design limit: the corrections of
-    neighbouring waypoints, each moved to pass its own target, hold each other where no small
-    step helps.  Searched again from those waypoints put back on their targets, every target
-    is held.  (A heuristic: over seeds 0-3 at rho 80 and 104 it leaves 14 targets beyond with
-    the second search and 14 without.)"""
+@pytest.fixture(scope="module")
+def clustered_stuck():
+    """A clustered site (80 targets, seed 2, rho 80 m; forecast wind only), its settings, and
+    its design without the local repair's second search (which leaves a target beyond)."""
     from dtsp_mission.api import plan_tour
-    from dtsp_mission.mission.widening import targets_beyond
     targets = _clustered(80, 2)
     tour, frame = plan_tour(targets, 80.0)
     settings = MissionSettings(design="guidance", airspeed_m_s=22.0, altitude_m=120.0,
                                home_deg=CENTRE, wind_spread_m_s=0.0)
     stuck = build_mission(tour, frame, targets, replace(
         settings, tuning=DesignTuning(local_reset=False)))
+    return tour, frame, targets, settings, stuck
+
+
+@pytest.mark.heavy(seconds=60)
+def test_the_local_repair_starts_again_from_the_targets_where_corrections_piled_up(clustered_stuck):
+    """On a clustered site (80 targets, seed 2, rho 80 m; forecast wind only) the pattern
+    search from the repaired aims leaves a target beyond the design limit: the corrections of
+    neighbouring waypoints, each moved to pass its own target, hold each other where no small
+    step helps.  Searched again from those waypoints put back on their targets, every target
+    is held.  (A heuristic: over seeds 0-3 at rho 80 and 104 it leaves 14 targets beyond with
+    the second search and 14 without.)"""
+    from dtsp_mission.mission.widening import targets_beyond
+    tour, frame, targets, settings, stuck = clustered_stuck
     held = build_mission(tour, frame, targets, settings)      # local_reset by default
     assert targets_beyond(stuck) > 0 and targets_beyond(held) == 0
     assert len(held.items) == len(stuck.items)          # the same waypoints, placed otherwise
@@ -317,22 +325,16 @@ def test_a_mission_designed_for_the_wind_holds_in_it_what_a_calm_design_misses()
 
 
 @pytest.mark.heavy(seconds=40)
-def test_a_target_left_beyond_is_passed_again_later_and_held():
+def test_a_target_left_beyond_is_passed_again_later_and_held(clustered_stuck):
     """On the clustered site of the test above, without the second search the design leaves a
     target beyond its limit; with revisits each such target is passed a second time later in
     the mission -- one waypoint over it, at its altitude and acceptance radius -- which brings
     it closer (here not within the limit: revisits are a heuristic, kept only when the robust
     cost falls), and the written mission, flown again from the start, passes the targets as
     the design reports."""
-    from dtsp_mission.api import plan_tour
     from dtsp_mission.mission.widening import targets_beyond as beyond
     from dtsp_mission.sim.fly import planned_targets
-    targets = _clustered(80, 2)
-    tour, frame = plan_tour(targets, 80.0)
-    settings = MissionSettings(design="guidance", airspeed_m_s=22.0, altitude_m=120.0,
-                               home_deg=CENTRE, wind_spread_m_s=0.0)
-    alone = build_mission(tour, frame, targets, replace(
-        settings, tuning=DesignTuning(local_reset=False)))
+    tour, frame, targets, settings, alone = clustered_stuck
     again = build_mission(tour, frame, targets, replace(
         settings, tuning=DesignTuning(local_reset=False, revisits=True)))
     assert beyond(alone) > 0 and beyond(again) <= beyond(alone)
