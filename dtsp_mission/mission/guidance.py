@@ -240,9 +240,9 @@ def revisited(marker: int) -> int:
 def waypoint_altitudes_m(path: FlightPath, s_wp, target_of) -> np.ndarray:
     """Each waypoint's altitude: the path's where it stands, a revisit's its target's."""
     altitudes = path.altitude_m(np.asarray(s_wp, dtype=float))
-    for k, marker in enumerate(target_of):
-        if revisited(int(marker)) >= 0:
-            altitudes[k] = path.altitude_m(np.array([path.target_s_m[revisited(int(marker))]]))[0]
+    of = np.array([revisited(int(marker)) for marker in target_of], dtype=np.int64)
+    again = of >= 0
+    altitudes[again] = path.altitude_m(path.target_s_m[of[again]])
     return altitudes
 
 
@@ -537,14 +537,15 @@ def _refine(aim: np.ndarray, target_of: list[int], items: list[LocalItem], seqs:
 
 def _with_revisits(s_wp: list[float], target_of: list[int], aim: np.ndarray,
                    targets_m: np.ndarray, beyond: list[int], tuning: DesignTuning,
+                   stored: Callable[[np.ndarray], np.ndarray],
                    end_s_m: float = math.inf) -> tuple[list[float], list[int], np.ndarray]:
-    """The waypoints with one more over each of ``beyond``, each where it lengthens the
-    straight legs least (turns at it weighed by ``revisit_turn_m`` per radian), at least
-    ``revisit_apart`` waypoints from the target's own."""
-    s_wp, target_of, points = list(s_wp), list(target_of), [p for p in np.asarray(aim)]
+    """The waypoints with one more over each of ``beyond`` (placed ``stored``, as the vehicle
+    keeps it), each where it lengthens the straight legs least (turns at it weighed by
+    ``revisit_turn_m`` per radian), at least ``revisit_apart`` waypoints from the target's own."""
+    s_wp, target_of, points = list(s_wp), list(target_of), list(np.asarray(aim))
     for t in beyond:
         own = target_of.index(t)
-        here = np.asarray(targets_m[t], dtype=float)
+        here = stored(np.asarray(targets_m[t], dtype=float)[None])[0]
         best, best_cost = None, math.inf
         for k in range(len(points) - 1):
             if (abs(k - own) < tuning.revisit_apart or abs(k + 1 - own) < tuning.revisit_apart
@@ -705,7 +706,7 @@ def design_waypoints(path: FlightPath, targets_m: np.ndarray, altitudes_m: np.nd
         if not beyond or room <= 0:
             break
         s_new, target_new, aim_new = _with_revisits(list(s_final), list(target_final), aim,
-                                                    targets_m, beyond[:room], tuning,
+                                                    targets_m, beyond[:room], tuning, stored,
                                                     path.tour_end_s_m)
         items, seqs = _local_items(takeoff, takeoff_alt, head_items, aim_new - home,
                                    waypoint_altitudes_m(path, s_new, target_new), target_new,
