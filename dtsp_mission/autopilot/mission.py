@@ -54,6 +54,18 @@ class Home:
     altitude_amsl_m: float = 0.0
 
 
+@dataclass(frozen=True)
+class MissionTarget:
+    """A target the mission was planned to pass -- not an item (the vehicle never receives it;
+    a guidance design aims its waypoint elsewhere): where it is, its altitude above home (NaN:
+    not given) and its name."""
+
+    name: str
+    latitude_deg: float
+    longitude_deg: float
+    altitude_m: float = float("nan")
+
+
 _POSITIONLESS_FRAMES = {2}      # MAV_FRAME_MISSION: x and y are parameters, not a position
 #: Frames whose altitude is above home or above the terrain (GLOBAL_RELATIVE_ALT, _INT,
 #: GLOBAL_TERRAIN_ALT, _INT): a navigation item there below 0 flies into the ground.
@@ -82,6 +94,9 @@ class VehicleMission:
     #: what the file holds beside the mission items, which an upload of the items does not
     #: carry ("a geofence of 1 polygon", "1 rally point")
     not_carried: tuple[str, ...] = ()
+    #: the targets it was planned for, in visiting order (a plan file written by dtsp-mission
+    #: carries them); empty: unknown
+    targets: tuple[MissionTarget, ...] = ()
 
     def problems(self) -> list[str]:
         """What no autopilot would take, or no operator would fly, from this mission: a home or

@@ -35,9 +35,10 @@ def fly(mission_file, rho_m, airspeed_m_s, max_bank_deg, speedup, vehicle_params
     """Upload MISSION_FILE to the simulated fixed wing, fly it, and print per-target miss
     distances and the flight time.
 
-    The targets are those of --targets FILE, or else the waypoints with an acceptance radius
-    (how dtsp-mission writes the targets' waypoints; the guidance design aims them off the
-    targets, so give --targets to measure what matters).
+    The targets are those of --targets FILE, or else those a .plan written by dtsp-mission
+    carries, or else the waypoints with an acceptance radius (how dtsp-mission writes the
+    targets' waypoints; the guidance design aims them off the targets, so give --targets to
+    measure what matters).
     The aircraft navigates like an ArduPlane with --vehicle-params (a stock one without);
     --radius or --max-bank limit its bank, --airspeed sets its cruise speed.
 
@@ -51,8 +52,10 @@ def fly(mission_file, rho_m, airspeed_m_s, max_bank_deg, speedup, vehicle_params
     try:
         if targets_file is None:
             targets = targets_in(mission)
-            note("misses are measured to the target waypoints of the file (the guidance design "
-                 "aims them off the targets): give --targets FILE to measure to the targets")
+            if not mission.targets:
+                note("misses are measured to the target waypoints of the file (the guidance "
+                     "design aims them off the targets): give --targets FILE to measure to the "
+                     "targets")
         else:
             targets = targets_from(read_geodetic_targets(targets_file))
             check_targets_near(mission, targets, f"--targets {targets_file}")

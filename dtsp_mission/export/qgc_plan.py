@@ -16,6 +16,7 @@ from typing import Any
 from ..errors import FileFormatError, TourInvalidError
 from ..files import read_text
 from ..mission import Autopilot, Home, Mission, MissionItem, VehicleMission
+from ..autopilot.mission import MissionTarget
 from ..autopilot.commands import VEHICLE_TYPE_FIXED_WING
 from .base import Exporter
 
@@ -61,9 +62,38 @@ def plan_dict(mission: Mission) -> dict[str, Any]:
         "geoFence": {"circles": [], "polygons": [], "version": 2},
         "rallyPoints": {"points": [], "version": 2},
     }
-    if mission.guidance is not None:     # readers ignore keys they do not know
-        document["dtspMission"] = {"designWind": mission.summary["design_wind"]}
+    # Readers ignore keys they do not know: the design wind, and the targets themselves (a
+    # guidance design aims their waypoints elsewhere), so that a flight of the file is
+    # measured against them.
+    ours: dict[str, Any] = {"targets": [
+        {"name": t.name, "latitude_deg": t.latitude_deg, "longitude_deg": t.longitude_deg,
+         **({} if math.isnan(t.altitude_m) else {"altitude_m": t.altitude_m})}
+        for t in mission.visited_targets()]}
+    if mission.guidance is not None:
+        ours["designWind"] = mission.summary["design_wind"]
+    document["dtspMission"] = ours
     return document
+
+
+def _carried_targets(path, ours: dict) -> tuple[MissionTarget, ...]:
+    """The targets a plan's ``dtspMission`` block carries (none if it has none), or
+    :class:`FileFormatError` naming the first that is not a named position on the globe."""
+    listed = ours.get("targets", [])
+    if not isinstance(listed, list):
+        raise FileFormatError(f"{path}: dtspMission.targets is not a list")
+    targets = []
+    for number, entry in enumerate(listed, start=1):
+        fields = entry if isinstance(entry, dict) else {}
+        lat, lon = fields.get("latitude_deg"), fields.get("longitude_deg")
+        altitude = fields.get("altitude_m", math.nan)
+        if not (isinstance(fields.get("name"), str) and _is_number(lat) and _is_number(lon)
+                and -90 <= lat <= 90 and -180 <= lon <= 180
+                and (_is_number(altitude) or altitude is math.nan)):
+            raise FileFormatError(f"{path}: dtspMission.targets entry {number} is not a target "
+                                  "(a name, latitude_deg in -90..90, longitude_deg in -180..180 "
+                                  "and an optional altitude_m)")
+        targets.append(MissionTarget(fields["name"], float(lat), float(lon), float(altitude)))
+    return tuple(targets)
 
 
 def _is_number(value: Any) -> bool:
@@ -204,13 +234,14 @@ class QGCPlanExporter(Exporter):
                                      params[5], params[6], item["autoContinue"]))
         if not items:
             raise FileFormatError(f"{path}: the plan holds no mission items")
-        wind = (data.get("dtspMission") or {}).get("designWind") if isinstance(
-            data.get("dtspMission"), dict) else None
+        ours = data.get("dtspMission") if isinstance(data.get("dtspMission"), dict) else {}
+        wind = ours.get("designWind")
         design_wind = None
         if isinstance(wind, dict) and all(_is_number(wind.get(k)) for k in ("speed_m_s", "from_deg")):
             design_wind = (float(wind["speed_m_s"]), float(wind["from_deg"]))
         read = VehicleMission(tuple(items), Home(*mission["plannedHomePosition"]), autopilot,
-                              design_wind=design_wind, not_carried=_beside_the_items(data))
+                              design_wind=design_wind, not_carried=_beside_the_items(data),
+                              targets=_carried_targets(path, ours))
         problems = read.problems()
         if problems:
             raise FileFormatError(f"{path}: " + "; ".join(problems[:3]))

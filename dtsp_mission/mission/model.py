@@ -16,7 +16,8 @@ from ..frame import LocalFrame
 from ..segments import SegmentChain
 from ..tour import Tour
 from ..autopilot.commands import Autopilot, Command, Frame
-from ..autopilot.mission import Home, MissionItem, VehicleMission, degrees_to_e7  # noqa: F401 (re-exported)
+from ..autopilot.mission import Home, MissionItem, MissionTarget, VehicleMission, degrees_to_e7  # noqa: F401 (re-exported)
+from ..targets.model import target_name
 
 
 @dataclass(frozen=True)
@@ -153,9 +154,20 @@ class Mission:
         numbers[order] = np.arange(len(order))
         return numbers
 
+    def visited_targets(self) -> tuple[MissionTarget, ...]:
+        """The targets themselves (not their waypoints, which the guidance design aims
+        elsewhere), in visiting order, with the altitude of their waypoint and their names."""
+        latitudes, longitudes = self.target_positions_deg
+        return tuple(MissionTarget(target_name(self.target_names, item.target),
+                                   float(latitudes[item.target]), float(longitudes[item.target]),
+                                   float(item.altitude_m))
+                     for item in self.items if item.role == "target")
+
     def for_vehicle(self) -> VehicleMission:
+        """The mission as a vehicle receives it, with the design wind and the targets."""
         return VehicleMission(self.items, self.home, self.autopilot,
-                              design_wind=None if self.guidance is None else self.guidance.design_wind)
+                              design_wind=None if self.guidance is None else self.guidance.design_wind,
+                              targets=self.visited_targets())
 
     def vehicle_item_count(self) -> int:
         """Mission slots on the vehicle: the items plus ArduPilot's home at seq 0."""

@@ -42,12 +42,14 @@ def planned_targets(mission) -> Targets:
     """The targets of a planned :class:`~dtsp_mission.mission.Mission` themselves (not their
     waypoints, which the guidance design aims elsewhere), in visiting order, with the
     altitude of their waypoint and their names."""
-    chosen = [item for item in mission.items if item.role == "target"]
-    latitudes, longitudes = mission.target_positions_deg
-    index = np.array([item.target for item in chosen], dtype=np.int64)
-    names = mission.target_names
-    return Targets(latitudes[index], longitudes[index], np.array([i.altitude_m for i in chosen]),
-                   tuple(target_name(names, i) for i in index))
+    return _as_targets(mission.visited_targets())
+
+
+def _as_targets(targets) -> Targets:
+    return Targets(np.array([t.latitude_deg for t in targets], dtype=float),
+                   np.array([t.longitude_deg for t in targets], dtype=float),
+                   np.array([t.altitude_m for t in targets], dtype=float),
+                   tuple(t.name for t in targets))
 
 
 def targets_from(geodetic) -> Targets:
@@ -106,9 +108,12 @@ def check_targets_near(mission: VehicleMission, targets: Targets, where: str) ->
 
 
 def targets_in(mission: VehicleMission, names: tuple[str, ...] | None = None) -> Targets:
-    """The mission's targets in visiting order: its ``target`` items (named from ``names``
-    by target index), or -- for items read from a file, which carry no roles -- every
+    """The mission's targets in visiting order: those it carries (a plan file written by
+    dtsp-mission, a planned mission), else its ``target`` items (named from ``names`` by target
+    index), or -- for items read from a file that carries no targets and no roles -- every
     NAV_WAYPOINT with an acceptance radius (how dtsp-mission writes targets)."""
+    if mission.targets:
+        return _as_targets(mission.targets)
     chosen = [item for item in mission.items if item.role == "target"]
     if chosen:
         labels = tuple(target_name(names, i.target) for i in chosen)

@@ -173,7 +173,7 @@ def test_targets_are_numbered_alike_in_every_output(mission, tmp_path):
     for t in targets:
         assert mission.items[t["item"] - 1].target == t["target"] - 1
     unnamed = replaced(mission, target_names=None)
-    labels = targets_in(unnamed).names
+    labels = targets_in(unnamed.for_vehicle()).names
     assert sorted(labels, key=lambda label: int(label.split()[1])) == \
         [f"target {k}" for k in range(1, count + 1)]
     kml = pytest.importorskip("dtsp_mission_kml")
@@ -195,3 +195,28 @@ def test_every_output_gives_the_same_two_lengths(mission, tmp_path):
     text = exporter_for("m.kml").render_for(mission, tmp_path / "m.kml")
     text = text.decode() if isinstance(text, bytes) else text
     assert f"flight: {flight_km} from take-off to the return ({tour_m}" in text
+
+
+def test_the_plan_carries_the_targets_themselves(mission, tmp_path):
+    """A .plan written here carries the targets (not their waypoints) in visiting order, so
+    that a flight of the file is measured against them; a plan from elsewhere carries none,
+    and a broken entry is refused by number."""
+    from dtsp_mission.errors import FileFormatError
+    from dtsp_mission.export import read_mission
+    path = tmp_path / "m.plan"
+    exporter_for(path).write(mission, path)
+    carried = read_mission(path).targets
+    assert carried == mission.visited_targets() and len(carried) == len(mission.target_items)
+    latitudes, longitudes = mission.target_positions_deg
+    visited = [item.target for item in mission.items if item.role == "target"]
+    assert [(t.latitude_deg, t.longitude_deg) for t in carried] == \
+        [(latitudes[k], longitudes[k]) for k in visited]
+    data = json.loads(path.read_text())
+    del data["dtspMission"]
+    path.write_text(json.dumps(data))
+    assert read_mission(path).targets == ()
+    data["dtspMission"] = {"targets": [{"name": "a", "latitude_deg": 46.8, "longitude_deg": 6.9},
+                                       {"name": "b", "latitude_deg": 95.0, "longitude_deg": 6.9}]}
+    path.write_text(json.dumps(data))
+    with pytest.raises(FileFormatError, match="dtspMission.targets entry 2"):
+        read_mission(path)
