@@ -50,14 +50,23 @@ S_RUN, S_RUN_SPEED = 19, 20                         # the take-off run
 S_ODOMETER = 21                                     # ground distance flown (sum of step chords)
 S_MEASURE_START = 22                                # the odometer when measuring began (NaN: not yet)
 S_XTRACK_I, S_LAST_WAYPOINT_UPDATE, S_LAST_NU = 23, 24, 25   # L1 integrator, its clock, last Nu
-STATE_SIZE = 26
+S_SPEED_TARGET = 26                                 # the airspeed the autopilot holds
+STATE_SIZE = 27
 
 # -- the airframe vector -----------------------------------------------------------------------
 (A_AIRSPEED, A_L1_PERIOD, A_WP_RADIUS, A_ROLL_W, A_ROLL_Z, A_L1_DAMPING,
  A_ROLL_LIMIT, A_LOITER_RADIUS, A_CLIMB, A_SINK, A_ALT_TC, A_TKO_ACCEL, A_TKO_CLIMB,
  A_TURN_EFFICIENCY, A_NAV_HZ, A_WIND_X, A_WIND_Y, A_WIND_FULL_ALT, A_TKO_PITCH,
  A_XTRACK_I_GAIN) = range(20)
-AIRFRAME_SIZE = 20
+# PX4's navigation instead of ArduPlane's (1.0), and its switch distance multiplier
+# (NPFG_SW_DST_MLT); for PX4, A_L1_PERIOD and A_L1_DAMPING are NPFG_PERIOD and NPFG_DAMPING
+# and A_WP_RADIUS is NAV_ACC_RAD.
+A_PX4, A_SWITCH_MULT = 20, 21
+# The airframe's true airspeed over the airspeed asked (DO_CHANGE_SPEED), the time constant its
+# airspeed follows a change with (0: at once) and the airspeed it climbs out at after the
+# take-off run (0: ArduPlane's rule, lift-off at 85 % of cruise).
+A_SPEED_RATIO, A_SPEED_TC, A_TKO_SPEED = 22, 23, 24
+AIRFRAME_SIZE = 25
 
 LOITER_EXIT_HEADING_RAD = math.radians(10.0)
 TWO_PI = 2.0 * math.pi
@@ -186,6 +195,53 @@ def _l1_lateral_accel(st, af, ax, ay, bx, by):
     return 4 * damping * damping * speed * speed / l1 * math.sin(eta)
 
 
+@numba.njit(inline="always", **_JIT)
+def npfg_track_error_bound(af, ground_speed):
+    """PX4 NPFG's track error bound: the ground speed times its time constant (period times
+    damping), held up below 1 m/s."""
+    time_const = af[A_L1_PERIOD] * af[A_L1_DAMPING]
+    if ground_speed > 1.0:
+        return ground_speed * time_const
+    return 0.5 * time_const * (ground_speed * ground_speed + 1.0)
+
+
+@numba.njit(**_JIT)
+def _npfg_lateral_accel(st, af, ax, ay, bx, by):
+    """PX4's NPFG for the line through A and B (towards B): lateral acceleration, positive to
+    the left.  The bearing turns from the path's normal (far off it) to its tangent (on it) as
+    the look-ahead angle pi/2 (1 - e)^2 of the track error e normalised by the track error
+    bound; the heading that makes the ground velocity follow the bearing in the wind is
+    tracked with the gain 4 pi damping / period on the airspeed (the most held beyond 90 deg
+    off)."""
+    x, y = st[S_X], st[S_Y]
+    _, _, ground = _ground_velocity(st, af)
+    tx, ty = bx - ax, by - ay
+    length = math.hypot(tx, ty)
+    if length < 1e-6:                       # no line: towards B
+        tx, ty = bx - x, by - y
+        length = max(math.hypot(tx, ty), 1e-9)
+    tx, ty = tx / length, ty / length
+    error = _cross(tx, ty, x - ax, y - ay)  # left of the path: positive
+    normalized = min(abs(error) / npfg_track_error_bound(af, ground), 1.0)
+    look_ahead = 0.5 * math.pi * (normalized - 1.0) * (normalized - 1.0)
+    side = -1.0 if error < 0.0 else 1.0
+    towards_x, towards_y = side * ty, -side * tx          # the normal towards the path
+    bearing_x = math.cos(look_ahead) * towards_x + math.sin(look_ahead) * tx
+    bearing_y = math.cos(look_ahead) * towards_y + math.sin(look_ahead) * ty
+    airspeed = st[S_AIRSPEED]
+    scale = _wind_scale(af, st[S_ALT])
+    wx, wy = af[A_WIND_X] * scale, af[A_WIND_Y] * scale
+    across = _cross(bearing_x, bearing_y, wx, wy)          # wind to the bearing's left
+    along = math.sqrt(max(airspeed * airspeed - across * across, 0.0))
+    heading_x = along * bearing_x + across * bearing_y     # cancels the crosswind
+    heading_y = along * bearing_y - across * bearing_x
+    off = _wrap(math.atan2(heading_y, heading_x) - st[S_HEADING])
+    gain = 4.0 * math.pi * af[A_L1_DAMPING] / af[A_L1_PERIOD]
+    if math.cos(off) < 0.0:
+        return gain * (airspeed if off > 0.0 else -airspeed)
+    return gain * airspeed * math.sin(off)
+
+
 @numba.njit(**_JIT)
 def _loiter_lateral_accel(st, af, cx, cy, radius, direction):
     """ArduPlane's L1 loiter law around (cx, cy): lateral acceleration (positive to the left)
@@ -264,14 +320,16 @@ def _is_nav(command):
 
 
 @numba.njit(**_JIT)
-def _skip_instant_items(st, command, params, reached, counts):
+def _skip_instant_items(st, af, command, params, reached, counts):
     """Items that do not navigate are done as they become current (DO_CHANGE_SPEED sets the
     airspeed)."""
     n = len(command)
     i = int(st[S_INDEX])
     while i < n and not _is_nav(command[i]):
         if command[i] == DO_CHANGE_SPEED and params[i, 1] > 0:
-            st[S_AIRSPEED] = params[i, 1]
+            st[S_SPEED_TARGET] = params[i, 1] * af[A_SPEED_RATIO]
+            if af[A_SPEED_TC] <= 0.0:
+                st[S_AIRSPEED] = st[S_SPEED_TARGET]
         _record_reached(reached, counts, i, st[S_TIME])
         i += 1
     st[S_INDEX] = i
@@ -304,7 +362,7 @@ def _complete(st, af, command, position, params, reached, counts, leg_x, leg_y, 
     st[S_INDEX] = i + 1
     st[S_LOITER] = 0.0
     st[S_RUN] = 0.0
-    _skip_instant_items(st, command, params, reached, counts)
+    _skip_instant_items(st, af, command, params, reached, counts)
 
 
 @numba.njit(**_JIT)
@@ -383,13 +441,19 @@ def _step_takeoff(st, af, command, position, params, reached, counts, dt):
             st[S_RUN] = 1.0
             st[S_RUN_SPEED] = 0.0
         cruise = af[A_AIRSPEED]
-        st[S_RUN_SPEED] = min(st[S_RUN_SPEED] + af[A_TKO_ACCEL] * dt, 1.16 * cruise)
-        climb = af[A_TKO_CLIMB] if st[S_RUN_SPEED] >= 0.85 * cruise else 0.0
+        if af[A_TKO_SPEED] > 0.0:            # up to the climb-out airspeed, lift-off there
+            top, lift_off = af[A_TKO_SPEED], af[A_TKO_SPEED]
+        else:
+            top, lift_off = 1.16 * cruise, 0.85 * cruise
+        st[S_RUN_SPEED] = min(st[S_RUN_SPEED] + af[A_TKO_ACCEL] * dt, top)
+        climb = af[A_TKO_CLIMB] if st[S_RUN_SPEED] >= lift_off else 0.0
         st[S_AIRSPEED] = max(st[S_RUN_SPEED], 1e-3)
         _fly(st, af, dt, 0.0, climb, 1.0)
     if st[S_ALT] >= position[i, 2]:
         st[S_ALT] = position[i, 2]
-        st[S_AIRSPEED] = af[A_AIRSPEED]
+        if af[A_SPEED_TC] <= 0.0:
+            st[S_AIRSPEED] = af[A_AIRSPEED]
+        st[S_SPEED_TARGET] = af[A_AIRSPEED]
         _complete(st, af, command, position, params, reached, counts, 0.0, 0.0, 0.0, False)
 
 
@@ -416,6 +480,8 @@ def step(st, af, command, position, params, following, reached, counts, dt):
     if c == NAV_TAKEOFF:
         _step_takeoff(st, af, command, position, params, reached, counts, dt)
         return
+    if af[A_SPEED_TC] > 0.0:
+        st[S_AIRSPEED] += (st[S_SPEED_TARGET] - st[S_AIRSPEED]) * min(dt / af[A_SPEED_TC], 1.0)
     if c == NAV_LOITER_TURNS or c == NAV_LOITER_TIME:
         _step_loiter(st, af, command, position, params, following, reached, counts, dt)
         return
@@ -438,8 +504,12 @@ def step(st, af, command, position, params, following, reached, counts, dt):
     else:
         climb = _toward_alt(st, af, wanted_alt, dt)
     tick = _navigation_tick(st, af)
+    px4 = af[A_PX4] > 0.0
     if tick:
-        st[S_DEMAND] = _l1_lateral_accel(st, af, ax, ay, bx, by)
+        if px4:
+            st[S_DEMAND] = _npfg_lateral_accel(st, af, ax, ay, bx, by)
+        else:
+            st[S_DEMAND] = _l1_lateral_accel(st, af, ax, ay, bx, by)
     _fly(st, af, dt, st[S_DEMAND], climb, 1.0)
     if not tick:
         return
@@ -452,6 +522,16 @@ def step(st, af, command, position, params, following, reached, counts, dt):
             _complete(st, af, command, position, params, reached, counts, 0.0, 0.0, 0.0, False)
         return
     acceptance = params[i, 1] if c == NAV_WAYPOINT else 0.0
+    if px4:
+        # PX4: within the item's acceptance radius (NAV_ACC_RAD without one) or the position
+        # controller's switch distance (NPFG_SW_DST_MLT of the track error bound), whichever
+        # is larger; no finish line.
+        _, _, speed = _ground_velocity(st, af)
+        acceptance = max(acceptance if acceptance > 0 else af[A_WP_RADIUS],
+                         af[A_SWITCH_MULT] * npfg_track_error_bound(af, speed))
+        if distance <= acceptance:
+            _complete(st, af, command, position, params, reached, counts, 0.0, 0.0, 0.0, False)
+        return
     if acceptance <= 0:
         _, _, speed = _ground_velocity(st, af)
         l1 = l1_distance(af, speed)
@@ -598,6 +678,7 @@ def new_state(heading_rad: float, airspeed_m_s: float, first_index: int) -> np.n
     st = np.zeros(STATE_SIZE)
     st[S_HEADING] = heading_rad
     st[S_AIRSPEED] = airspeed_m_s
+    st[S_SPEED_TARGET] = airspeed_m_s
     st[S_INDEX] = first_index
     st[S_MEASURE_START] = math.nan
     st[S_LAST_WAYPOINT_UPDATE] = -math.inf
@@ -605,6 +686,6 @@ def new_state(heading_rad: float, airspeed_m_s: float, first_index: int) -> np.n
 
 
 @numba.njit(**_JIT)
-def start(st, command, params, reached, counts):
+def start(st, af, command, params, reached, counts):
     """Skips the instant items at the start of the mission."""
-    _skip_instant_items(st, command, params, reached, counts)
+    _skip_instant_items(st, af, command, params, reached, counts)

@@ -22,7 +22,7 @@ import numpy as np
 from . import flight_kernel as K
 from ..errors import InputError
 from .commands import Command, Frame
-from .parameters import ARDUPLANE_DEFAULTS, VehicleParameters
+from .parameters import ARDUPLANE_DEFAULTS, PX4_DEFAULTS, PX4Parameters, VehicleParameters
 
 G = K.G
 TAKEOFF_PITCH_DEG = 15.0
@@ -42,6 +42,19 @@ FLIGHT_LIMIT_S = 36000.0
 #: The take-off run of ArduPlane SITL's stock plane (fitted to the recorded climbs: 43 m run
 #: in the first 4 s, lift-off at 85 % of the cruise airspeed after about 3.5 s).
 TAKEOFF_ACCEL_M_S2 = 5.3
+#: PX4 SITL's SIH fixed wing (airframe 10041), fitted to the flights of tests/data/px4-sitl:
+#: its true airspeed over the airspeed asked (13.9 m/s over the ground in calm air at
+#: FW_AIRSPD_TRIM 15), its turn rate over the coordinated rate for its bank (regression of
+#: the course rate on the roll: 1.09-1.19) and its roll response.
+SIH_AIRSPEED_RATIO = 13.9 / 15.0
+SIH_TURN_EFFICIENCY = 1.1
+SIH_ROLL_NATURAL_RAD_S = 4.0
+SIH_ROLL_DAMPING = 0.7
+#: ... its take-off: the run at 5 m/s^2, lift-off and climb-out at 10 m/s (FW_AIRSPD_MIN),
+#: climbing at FW_T_CLMB_MAX; after it the airspeed grows to cruise with an 18 s time constant.
+SIH_TAKEOFF_ACCEL_M_S2 = 5.0
+SIH_TAKEOFF_AIRSPEED_M_S = 10.0
+SIH_AIRSPEED_TC_S = 18.0
 #: LOITER_TURNS with the tangent exit leaves when the course is this close to the next waypoint.
 LOITER_EXIT_HEADING_RAD = math.radians(10.0)
 
@@ -83,6 +96,20 @@ class Airframe:
     navigation_hz: float = ARDUPLANE_DEFAULTS.SCHED_LOOP_RATE
     #: ArduPlane's NAVL1_XTRACK_I: the cross-track integrator's gain (0: none).
     xtrack_i_gain: float = ARDUPLANE_DEFAULTS.NAVL1_XTRACK_I
+    #: Whose navigation flies it: ArduPlane's (``"ardupilot"``) or PX4's (``"px4"``: NPFG
+    #: path following, its waypoint switching; ``l1_period_s``/``l1_damping`` are then
+    #: NPFG_PERIOD/NPFG_DAMPING, ``wp_radius_m`` NAV_ACC_RAD).  See :meth:`from_px4_parameters`.
+    autopilot: str = "ardupilot"
+    #: PX4's NPFG_SW_DST_MLT: it switches to the next waypoint this fraction of the track
+    #: error bound before a waypoint (when that exceeds the acceptance radius).
+    switch_distance_multiplier: float = PX4_DEFAULTS.NPFG_SW_DST_MLT
+    #: The aircraft's true airspeed over an airspeed asked for (DO_CHANGE_SPEED).
+    airspeed_ratio: float = 1.0
+    #: The time constant its airspeed follows a change with (s; 0: at once).
+    airspeed_time_constant_s: float = 0.0
+    #: The airspeed it lifts off and climbs out at (0: ArduPlane SITL's: lift-off at 85 % of
+    #: the cruise airspeed, accelerating on to 116 % in the climb).
+    takeoff_airspeed_m_s: float = 0.0
 
     @classmethod
     def from_parameters(cls, parameters: VehicleParameters = ARDUPLANE_DEFAULTS,
@@ -96,6 +123,26 @@ class Airframe:
                    altitude_time_constant_s=parameters.TECS_TIME_CONST,
                    navigation_hz=parameters.SCHED_LOOP_RATE,
                    xtrack_i_gain=parameters.NAVL1_XTRACK_I)
+
+    @classmethod
+    def from_px4_parameters(cls, parameters: PX4Parameters = PX4_DEFAULTS,
+                            airspeed_m_s: float | None = None) -> "Airframe":
+        """The airframe a PX4 with these parameters flies as: PX4 SITL's SIH fixed wing (its
+        true airspeed, roll response and turn rate fitted to the flights of
+        ``tests/data/px4-sitl``) under PX4's NPFG guidance; ``airspeed_m_s`` is the airspeed
+        asked for (its trim airspeed, ``FW_AIRSPD_TRIM``, if None)."""
+        asked = airspeed_m_s or parameters.FW_AIRSPD_TRIM
+        return cls(asked * SIH_AIRSPEED_RATIO, parameters.FW_R_LIM, parameters.NPFG_PERIOD,
+                   parameters.NAV_ACC_RAD, roll_natural_rad_s=SIH_ROLL_NATURAL_RAD_S,
+                   roll_damping=SIH_ROLL_DAMPING, l1_damping=parameters.NPFG_DAMPING,
+                   loiter_radius_m=parameters.NAV_LOITER_RAD,
+                   max_climb_m_s=parameters.FW_T_CLMB_MAX, max_sink_m_s=parameters.FW_T_SINK_MAX,
+                   takeoff_climb_m_s=parameters.FW_T_CLMB_MAX,
+                   takeoff_accel_m_s2=SIH_TAKEOFF_ACCEL_M_S2,
+                   turn_efficiency=SIH_TURN_EFFICIENCY, navigation_hz=0.0, xtrack_i_gain=0.0,
+                   autopilot="px4", switch_distance_multiplier=parameters.NPFG_SW_DST_MLT,
+                   airspeed_ratio=SIH_AIRSPEED_RATIO, airspeed_time_constant_s=SIH_AIRSPEED_TC_S,
+                   takeoff_airspeed_m_s=SIH_TAKEOFF_AIRSPEED_M_S)
 
     @classmethod
     def turning_at(cls, rho_m: float, airspeed_m_s: float | None = None,
@@ -174,6 +221,33 @@ def parameters_with(parameters: VehicleParameters, airspeed_m_s: float | None = 
         if not 0 < max_bank_deg < 90:
             raise InputError(f"the maximum bank must be between 0 and 90 deg, got {max_bank_deg:g}")
         parameters = replace(parameters, ROLL_LIMIT_DEG=max_bank_deg)
+    return parameters
+
+
+def px4_parameters_with(parameters: PX4Parameters, airspeed_m_s: float | None = None,
+                        max_bank_deg: float | None = None, period_s: float | None = None,
+                        rho_m: float | None = None) -> PX4Parameters:
+    """``parameters`` with the trim airspeed, the roll limit (``FW_R_LIM``) and NPFG_PERIOD
+    replaced where given; ``rho_m`` without ``max_bank_deg`` sets the roll limit at which the
+    PX4 model aircraft turns no tighter than ``rho_m``.  :class:`InputError` for a value out of
+    range."""
+    if airspeed_m_s is not None:
+        if not airspeed_m_s > 0:
+            raise InputError(f"the airspeed must be above 0 m/s, got {airspeed_m_s:g}")
+        parameters = replace(parameters, FW_AIRSPD_TRIM=airspeed_m_s)
+    if period_s is not None:
+        if not period_s > 0:
+            raise InputError(f"the guidance period must be above 0 s, got {period_s:g}")
+        parameters = replace(parameters, NPFG_PERIOD=period_s)
+    if max_bank_deg is not None or rho_m is not None:
+        if max_bank_deg is None:
+            if not rho_m > 0:
+                raise InputError(f"the turn radius must be above 0 m, got {rho_m:g}")
+            max_bank_deg = bank_for_radius_deg(rho_m, parameters.FW_AIRSPD_TRIM * SIH_AIRSPEED_RATIO,
+                                               SIH_TURN_EFFICIENCY)
+        if not 0 < max_bank_deg < 90:
+            raise InputError(f"the maximum bank must be between 0 and 90 deg, got {max_bank_deg:g}")
+        parameters = replace(parameters, FW_R_LIM=max_bank_deg)
     return parameters
 
 
@@ -288,6 +362,11 @@ def airframe_vector(airframe: Airframe, wind: Wind = CALM) -> np.ndarray:
     v[K.A_WIND_FULL_ALT] = wind.full_altitude_m
     v[K.A_TKO_PITCH] = TAKEOFF_PITCH_DEG
     v[K.A_XTRACK_I_GAIN] = airframe.xtrack_i_gain
+    v[K.A_PX4] = 1.0 if airframe.autopilot == "px4" else 0.0
+    v[K.A_SWITCH_MULT] = airframe.switch_distance_multiplier
+    v[K.A_SPEED_RATIO] = airframe.airspeed_ratio
+    v[K.A_SPEED_TC] = airframe.airspeed_time_constant_s
+    v[K.A_TKO_SPEED] = airframe.takeoff_airspeed_m_s
     return v
 
 
@@ -372,8 +451,8 @@ class MissionFlight:
         self._reached = np.zeros((n + 1, 2))
         self._counts = np.zeros(2, dtype=np.int64)
         if n:
-            K.start(self._state, self.mission.command, self.mission.params, self._reached,
-                    self._counts)
+            K.start(self._state, self._af, self.mission.command, self.mission.params,
+                    self._reached, self._counts)
         else:
             self._state[K.S_FINISHED] = 1.0
 

@@ -122,3 +122,46 @@ def read_parameters(path: str | os.PathLike) -> VehicleParameters:
     values = parse_parameters(text, str(path))
     check_parameters(values, str(path))
     return parameters_from(values)
+
+
+@dataclass(frozen=True)
+class PX4Parameters:
+    """The fixed-wing navigation parameters of a PX4 (v1.16), by their PX4 names (units as
+    there); the defaults are PX4's stock values, as a stock PX4 SITL reports them
+    (``tests/data/px4-sitl/*/params.parm``)."""
+
+    NPFG_PERIOD: float = 10.0         # s
+    NPFG_DAMPING: float = 0.7
+    NPFG_SW_DST_MLT: float = 0.32     # the switch distance over the track error bound
+    NAV_ACC_RAD: float = 10.0         # m
+    NAV_LOITER_RAD: float = 80.0      # m
+    FW_AIRSPD_TRIM: float = 15.0      # m/s
+    FW_R_LIM: float = 50.0            # deg
+    FW_T_CLMB_MAX: float = 5.0        # m/s
+    FW_T_SINK_MAX: float = 5.0        # m/s
+
+
+PX4_DEFAULTS = PX4Parameters()
+PX4_NAMES = tuple(f.name for f in fields(PX4Parameters))
+PX4_RANGES: dict[str, tuple[float, float]] = {
+    "NPFG_PERIOD": (1.0, 100.0), "NPFG_DAMPING": (0.1, 1.0), "NPFG_SW_DST_MLT": (0.0, 1.0),
+    "NAV_ACC_RAD": (0.05, 200.0), "NAV_LOITER_RAD": (25.0, 1000.0),
+    "FW_AIRSPD_TRIM": (0.5, 40.0), "FW_R_LIM": (35.0, 65.0), "FW_T_CLMB_MAX": (0.5, 15.0),
+    "FW_T_SINK_MAX": (0.5, 15.0),
+}
+
+
+def read_px4_parameters(path: str | os.PathLike) -> PX4Parameters:
+    """The fixed-wing navigation parameters in a parameter file (``NAME VALUE`` lines, as
+    the SITL's and QGroundControl's exports give them once reduced to name and value); PX4's
+    stock values for any it lacks.  :class:`FileFormatError` for a value out of PX4's range."""
+    try:
+        text = Path(path).read_text(encoding="utf-8", errors="replace")
+    except OSError as error:
+        raise FileAccessError(f"cannot read the vehicle parameters {path}: {error.strerror}") from None
+    values = parse_parameters(text, str(path))
+    for name, (low, high) in PX4_RANGES.items():
+        if name in values and not (math.isfinite(values[name]) and low <= values[name] <= high):
+            raise FileFormatError(f"{path}: {name} {values[name]:g} is out of its range "
+                                  f"{low:g} .. {high:g}")
+    return replace(PX4_DEFAULTS, **{name: values[name] for name in PX4_NAMES if name in values})

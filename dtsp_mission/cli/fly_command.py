@@ -48,7 +48,7 @@ def fly(mission_file, rho_m, airspeed_m_s, max_bank_deg, speedup, vehicle_params
     console.start(quiet, as_json)
     mission = read_mission(mission_file, format_name)
     airframe, _, _ = airframe_from(vehicle_params_file, airspeed_m_s, max_bank_deg, l1_period_s,
-                                   rho_m)
+                                   rho_m, mission.autopilot)
     try:
         if targets_file is None:
             targets = targets_in(mission)

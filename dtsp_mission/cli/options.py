@@ -224,11 +224,12 @@ simulation_options = [
     click.option("--vehicle-params", "vehicle_params_file", type=click.Path(dir_okay=False),
                  metavar="FILE.parm", help="The vehicle's parameters (NAME VALUE lines, as "
                  "ArduPilot and MAVProxy write them): the flight model navigates with its "
-                 "NAVL1_*, WP_RADIUS, ROLL_LIMIT_DEG, AIRSPEED_CRUISE, TECS_*; default a stock "
-                 "ArduPlane's."),
+                 "NAVL1_*, WP_RADIUS, ROLL_LIMIT_DEG, AIRSPEED_CRUISE, TECS_*; for a PX4 "
+                 "mission its NPFG_PERIOD, NPFG_DAMPING, NPFG_SW_DST_MLT, NAV_ACC_RAD, FW_R_LIM, "
+                 "FW_AIRSPD_TRIM, FW_T_*; default a stock vehicle's."),
     click.option("--l1-period", "l1_period_s", type=float, metavar="S",
                  help="Override NAVL1_PERIOD, the L1 navigation period of the simulated "
-                      "autopilot."),
+                      "autopilot (NPFG_PERIOD for PX4)."),
     click.option("--wind", type=WIND, metavar="SPEED@FROM_DEG",
                  help="Steady wind: m/s @ degrees true it comes from (6@270: 6 m/s from the "
                       "west), full strength above 60 m.  The simulated aircraft flies in it; "
@@ -266,17 +267,30 @@ def progress_reporter(label: str):
 
 
 def airframe_from(vehicle_params_file, airspeed_m_s, max_bank_deg, l1_period_s,
-                  rho_m=None):
-    """The simulated aircraft: an ArduPlane with the parameters of ``vehicle_params_file``
-    (a stock one without), overridden by the options given: ``--airspeed`` (cruise),
-    ``--max-bank`` (roll limit), ``--radius`` (a roll limit that turns no tighter than it),
-    ``--l1-period``; and the one-line description of it the commands print."""
+                  rho_m=None, autopilot="ardupilot"):
+    """The simulated aircraft: an ArduPlane (or, for ``autopilot`` PX4, a PX4 flying PX4
+    SITL's fixed wing) with the parameters of ``vehicle_params_file`` (a stock one without),
+    overridden by the options given: ``--airspeed`` (cruise, PX4's trim), ``--max-bank`` (roll
+    limit), ``--radius`` (a roll limit that turns no tighter than it), ``--l1-period`` (PX4's
+    NPFG_PERIOD); and the one-line description of it the commands print."""
+    from ..autopilot.commands import Autopilot
     from ..autopilot.navigation import Airframe, parameters_with
     from ..autopilot.parameters import ARDUPLANE_DEFAULTS
-    parameters = designed_for(vehicle_params_file) or ARDUPLANE_DEFAULTS
-    parameters = parameters_with(parameters, airspeed_m_s, max_bank_deg, l1_period_s, rho_m)
     origin = (f"parameters from {vehicle_params_file}" if vehicle_params_file
               else "stock parameters")
+    if autopilot in ("px4", Autopilot.PX4):
+        from ..autopilot.navigation import px4_parameters_with
+        from ..autopilot.parameters import PX4_DEFAULTS, read_px4_parameters
+        px4 = read_px4_parameters(vehicle_params_file) if vehicle_params_file else PX4_DEFAULTS
+        px4 = px4_parameters_with(px4, airspeed_m_s, max_bank_deg, l1_period_s, rho_m)
+        airframe = Airframe.from_px4_parameters(px4)
+        source = (f"PX4 navigation (NPFG): {origin}, trim airspeed {px4.FW_AIRSPD_TRIM:g} m/s "
+                  f"({airframe.airspeed_m_s:.1f} m/s true, as PX4 SITL's fixed wing flies it), "
+                  f"roll limit {px4.FW_R_LIM:.0f} deg, NPFG_PERIOD {px4.NPFG_PERIOD:g} s, "
+                  f"NAV_ACC_RAD {px4.NAV_ACC_RAD:g} m")
+        return airframe, ARDUPLANE_DEFAULTS, source
+    parameters = designed_for(vehicle_params_file) or ARDUPLANE_DEFAULTS
+    parameters = parameters_with(parameters, airspeed_m_s, max_bank_deg, l1_period_s, rho_m)
     source = (f"ArduPlane navigation: {origin}, cruise {parameters.AIRSPEED_CRUISE:g} m/s, roll "
               f"limit {parameters.ROLL_LIMIT_DEG:.0f} deg, NAVL1_PERIOD "
               f"{parameters.NAVL1_PERIOD:g} s, WP_RADIUS {parameters.WP_RADIUS:g} m")

@@ -265,7 +265,8 @@ def plan(targets_file, random_count, area_file, seed, origin, rho_m, airspeed_m_
             console.current().summary.setdefault("files", []).append(str(output))
     if simulate:
         from ..sim.fly import planned_targets
-        airframe, _, _ = airframe_from(vehicle_params_file, airspeed_m_s, None, l1_period_s)
+        airframe, _, _ = airframe_from(vehicle_params_file, airspeed_m_s, None, l1_period_s,
+                                       autopilot=product.autopilot)
         for k, flown in enumerate([s.mission for s in sorties] or [product]):
             if sorties:
                 say(f"sortie {k + 1} of {len(sorties)}:")

@@ -102,7 +102,8 @@ def print_check(check: FlightCheck) -> None:
                                                                check.altitude_error_m)],
                    "max_miss_m": check.max_miss_m})
     say(f"simulated flight {state}: {check.items_reached} of {check.items} items, "
-               f"{minutes:.1f} min of flight (L1 period {check.airframe.l1_period_s:g} s, "
+               f"{minutes:.1f} min of flight ({'NPFG' if check.airframe.autopilot == 'px4' else 'L1'} "
+               f"period {check.airframe.l1_period_s:g} s, "
                f"min turn radius {check.airframe.tightest_turn_m:.0f} m)")
     say(f"uploaded via {check.upload.via} in {check.upload.seconds:.2f} s; "
                f"{check.samples} position reports received")

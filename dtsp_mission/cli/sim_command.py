@@ -50,7 +50,7 @@ def sim(listen, gcs, home_deg, home_amsl_m, autopilot, rho_m, airspeed_m_s, max_
     (then: dtsp-mission upload mission.plan --connect tcp:127.0.0.1:5760)
     """
     airframe, parameters, source = airframe_from(vehicle_params_file, airspeed_m_s, max_bank_deg,
-                                                 l1_period_s, rho_m)
+                                                 l1_period_s, rho_m, autopilot)
     settings = VehicleSettings(Home(*home_deg, home_amsl_m), AUTOPILOTS[autopilot], airframe,
                                speedup, max_items=max_items, autostart=autostart,
                                signing_key=read_signing_key(signing_key_file) if signing_key_file else None,

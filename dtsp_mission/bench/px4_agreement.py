@@ -1,0 +1,75 @@
+"""How closely the flight model, flying as PX4 navigates, reproduces a recorded PX4 flight.
+
+A case folder holds what a real PX4 SITL (v1.16, its SIH fixed wing) was given and what it
+did, in the format of ``tests/data/px4-sitl`` (read its README): ``mission.plan``,
+``params.parm`` (PX4's names), ``track.csv`` (10 Hz, east/north in the plan's home frame),
+``reached.csv`` (MISSION_ITEM_REACHED as received, repeated about once a second: the first of
+each seq counts), ``items.csv`` (closest approach of the whole track to each navigation item)
+and, for planned missions, ``misses.csv``.  :func:`compare_px4_case` flies the mission as PX4
+stored it with the case's parameters (:meth:`Airframe.from_px4_parameters`) and measures what
+:mod:`.arduplane_agreement` measures, so the tables read alike.  These flights are not
+lock-stepped: a repeated real flight differs by a metre or two.
+"""
+
+from __future__ import annotations
+
+from dataclasses import replace
+from pathlib import Path
+
+import numpy as np
+
+from ..autopilot import Autopilot, Command
+from ..autopilot.navigation import MODEL_STEP_S, Airframe, closest_approach_m
+from ..autopilot.parameters import read_px4_parameters
+from ..export import read_mission
+from ..sim.predict import predict_flight
+from .arduplane_agreement import RECORDED_AFTER_S, Agreement, _length, _rows
+
+
+def compare_px4_case(folder: str | Path, airframe: Airframe | None = None,
+                     dt_s: float = MODEL_STEP_S) -> Agreement:
+    """The PX4 model against the recorded PX4 flight in ``folder``."""
+    folder = Path(folder)
+    airframe = airframe or Airframe.from_px4_parameters(read_px4_parameters(folder / "params.parm"))
+    # uploaded in plan order, as PX4 stores it (the hand-made plans say ArduPilot)
+    mission = replace(read_mission(folder / "mission.plan"), autopilot=Autopilot.PX4)
+    predicted = predict_flight(mission, airframe, dt_s, RECORDED_AFTER_S, 7200.0)
+    model, frame, model_reached = predicted.track, predicted.frame, dict(predicted.flight.reached)
+
+    real_reached: dict[int, float] = {}
+    for row in _rows(folder / "reached.csv"):
+        real_reached.setdefault(int(row["seq"]), float(row["time_s"]))
+    # the take-off's reach (seq 0), or where PX4 did not report it, the first item after it
+    start_real = real_reached.get(0, real_reached[min(real_reached)])
+    start_model = model_reached.get(0, 0.0)
+    common = sorted(seq for seq in real_reached if seq in model_reached and seq > 0)
+    end = common[-1]
+    scale = (real_reached[end] - start_real) / max(model_reached[end] - start_model, 1e-9)
+    timing = np.array([abs((model_reached[q] - start_model) * scale - (real_reached[q] - start_real))
+                       for q in common])
+
+    rows = _rows(folder / "track.csv")
+    real_t = np.array([float(r["time_s"]) for r in rows])
+    real_xy = frame.to_local(np.array([float(r["lat"]) for r in rows]),
+                             np.array([float(r["lon"]) for r in rows]))
+    real_xy = real_xy[(real_t >= start_real) & (real_t <= real_reached[end])]
+    model_xy = model[(model[:, 0] >= start_model) & (model[:, 0] <= model_reached[end]), 1:3]
+    track = closest_approach_m(model_xy, real_xy)
+
+    after_takeoff = model[model[:, 0] >= start_model, 1:3]
+    if (folder / "misses.csv").exists():       # targets
+        points = _rows(folder / "misses.csv")
+        real_closest = np.array([float(r["miss_m"]) for r in points])
+    else:       # waypoints before the last one reached (the recording stops as it is reached)
+        points = [r for r in _rows(folder / "items.csv")
+                  if int(r["command"]) == Command.NAV_WAYPOINT and int(r["seq"]) < end]
+        real_closest = np.array([float(r["closest_whole_track_m"]) for r in points])
+    xy = frame.to_local(np.array([float(r["lat"]) for r in points]),
+                        np.array([float(r["lon"]) for r in points]))
+    model_closest = closest_approach_m(after_takeoff, xy)
+    difference = np.abs(model_closest - real_closest)
+    return Agreement(folder.name, len(common), float(np.median(timing)), float(timing.max()),
+                     float(np.median(track)), float(np.percentile(track, 95)), float(track.max()),
+                     len(points), float(np.median(difference)), float(difference.max()),
+                     float(np.median(real_closest)), float(np.median(model_closest)),
+                     _length(real_xy), _length(model_xy))
