@@ -66,7 +66,8 @@ A_PX4, A_SWITCH_MULT = 20, 21
 # airspeed follows a change with (0: at once) and the airspeed it climbs out at after the
 # take-off run (0: ArduPlane's rule, lift-off at 85 % of cruise).
 A_SPEED_RATIO, A_SPEED_TC, A_TKO_SPEED = 22, 23, 24
-AIRFRAME_SIZE = 25
+A_MAX_SPEED = 25                                     # the most airspeed it flies (0: no limit)
+AIRFRAME_SIZE = 26
 
 LOITER_EXIT_HEADING_RAD = math.radians(10.0)
 TWO_PI = 2.0 * math.pi
@@ -328,6 +329,8 @@ def _skip_instant_items(st, af, command, params, reached, counts):
     while i < n and not _is_nav(command[i]):
         if command[i] == DO_CHANGE_SPEED and params[i, 1] > 0:
             st[S_SPEED_TARGET] = params[i, 1] * af[A_SPEED_RATIO]
+            if af[A_MAX_SPEED] > 0.0:
+                st[S_SPEED_TARGET] = min(st[S_SPEED_TARGET], af[A_MAX_SPEED])
             if af[A_SPEED_TC] <= 0.0:
                 st[S_AIRSPEED] = st[S_SPEED_TARGET]
         _record_reached(reached, counts, i, st[S_TIME])

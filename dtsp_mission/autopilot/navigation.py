@@ -110,6 +110,8 @@ class Airframe:
     #: The airspeed it lifts off and climbs out at (0: ArduPlane SITL's: lift-off at 85 % of
     #: the cruise airspeed, accelerating on to 116 % in the climb).
     takeoff_airspeed_m_s: float = 0.0
+    #: The most airspeed it flies, whatever is asked (0: no limit; PX4: FW_AIRSPD_MAX).
+    max_airspeed_m_s: float = 0.0
 
     @classmethod
     def from_parameters(cls, parameters: VehicleParameters = ARDUPLANE_DEFAULTS,
@@ -130,8 +132,9 @@ class Airframe:
         """The airframe a PX4 with these parameters flies as: PX4 SITL's SIH fixed wing (its
         true airspeed, roll response and turn rate fitted to the flights of
         ``tests/data/px4-sitl``) under PX4's NPFG guidance; ``airspeed_m_s`` is the airspeed
-        asked for (its trim airspeed, ``FW_AIRSPD_TRIM``, if None)."""
-        asked = airspeed_m_s or parameters.FW_AIRSPD_TRIM
+        asked for (its trim airspeed, ``FW_AIRSPD_TRIM``, if None; PX4 flies no faster than
+        ``FW_AIRSPD_MAX``)."""
+        asked = min(airspeed_m_s or parameters.FW_AIRSPD_TRIM, parameters.FW_AIRSPD_MAX)
         return cls(asked * SIH_AIRSPEED_RATIO, parameters.FW_R_LIM, parameters.NPFG_PERIOD,
                    parameters.NAV_ACC_RAD, roll_natural_rad_s=SIH_ROLL_NATURAL_RAD_S,
                    roll_damping=SIH_ROLL_DAMPING, l1_damping=parameters.NPFG_DAMPING,
@@ -142,7 +145,8 @@ class Airframe:
                    turn_efficiency=SIH_TURN_EFFICIENCY, navigation_hz=0.0, xtrack_i_gain=0.0,
                    autopilot="px4", switch_distance_multiplier=parameters.NPFG_SW_DST_MLT,
                    airspeed_ratio=SIH_AIRSPEED_RATIO, airspeed_time_constant_s=SIH_AIRSPEED_TC_S,
-                   takeoff_airspeed_m_s=SIH_TAKEOFF_AIRSPEED_M_S)
+                   takeoff_airspeed_m_s=SIH_TAKEOFF_AIRSPEED_M_S,
+                   max_airspeed_m_s=parameters.FW_AIRSPD_MAX * SIH_AIRSPEED_RATIO)
 
     @classmethod
     def turning_at(cls, rho_m: float, airspeed_m_s: float | None = None,
@@ -367,6 +371,7 @@ def airframe_vector(airframe: Airframe, wind: Wind = CALM) -> np.ndarray:
     v[K.A_SPEED_RATIO] = airframe.airspeed_ratio
     v[K.A_SPEED_TC] = airframe.airspeed_time_constant_s
     v[K.A_TKO_SPEED] = airframe.takeoff_airspeed_m_s
+    v[K.A_MAX_SPEED] = airframe.max_airspeed_m_s
     return v
 
 

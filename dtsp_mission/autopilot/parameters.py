@@ -136,6 +136,7 @@ class PX4Parameters:
     NAV_ACC_RAD: float = 10.0         # m
     NAV_LOITER_RAD: float = 80.0      # m
     FW_AIRSPD_TRIM: float = 15.0      # m/s
+    FW_AIRSPD_MAX: float = 20.0       # m/s
     FW_R_LIM: float = 50.0            # deg
     FW_T_CLMB_MAX: float = 5.0        # m/s
     FW_T_SINK_MAX: float = 5.0        # m/s
@@ -146,7 +147,7 @@ PX4_NAMES = tuple(f.name for f in fields(PX4Parameters))
 PX4_RANGES: dict[str, tuple[float, float]] = {
     "NPFG_PERIOD": (1.0, 100.0), "NPFG_DAMPING": (0.1, 1.0), "NPFG_SW_DST_MLT": (0.0, 1.0),
     "NAV_ACC_RAD": (0.05, 200.0), "NAV_LOITER_RAD": (25.0, 1000.0),
-    "FW_AIRSPD_TRIM": (0.5, 40.0), "FW_R_LIM": (35.0, 65.0), "FW_T_CLMB_MAX": (0.5, 15.0),
+    "FW_AIRSPD_TRIM": (0.5, 40.0), "FW_AIRSPD_MAX": (0.5, 40.0), "FW_R_LIM": (35.0, 65.0), "FW_T_CLMB_MAX": (0.5, 15.0),
     "FW_T_SINK_MAX": (0.5, 15.0),
 }
 

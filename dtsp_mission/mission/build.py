@@ -14,7 +14,7 @@ the approach waypoint and NAV_LAND at home, or nothing.
 from __future__ import annotations
 
 from collections import Counter
-from dataclasses import dataclass, replace
+from dataclasses import dataclass
 from typing import Callable
 
 import numpy as np
@@ -26,7 +26,7 @@ from ..targets.model import target_name
 from ..tour import Tour
 from ..vehicle import bearing_to_heading_rad, heading_to_bearing_deg
 from ..autopilot.commands import AUTOPILOTS, Command
-from ..autopilot.parameters import ARDUPLANE_DEFAULTS
+from ..autopilot.parameters import ARDUPLANE_DEFAULTS, PX4_DEFAULTS, PX4Parameters, VehicleParameters
 from . import actions as action_items
 from .flight_path import climb_distance_m, plan_flight_path
 from .items import mission_items
@@ -62,6 +62,11 @@ def _prepare(tour: Tour, frame: LocalFrame, targets: GeoTargets,
         home_lat, home_lon = settings.home_deg
         frame.check_extent(home_lat, home_lon, "targets and home")
     home_m = frame.to_local(home_lat, home_lon)[0]
+    if settings.autopilot == "px4" and settings.airspeed_m_s is not None:
+        px4 = settings.vehicle if isinstance(settings.vehicle, PX4Parameters) else PX4_DEFAULTS
+        if settings.airspeed_m_s > px4.FW_AIRSPD_MAX:
+            notes.append(f"PX4 flies no faster than FW_AIRSPD_MAX ({px4.FW_AIRSPD_MAX:g} m/s): "
+                         f"asked {settings.airspeed_m_s:g} m/s, the mission is designed at that")
     if settings.autopilot == "px4" and settings.return_mode != "land":
         notes.append("PX4 refuses to start a fixed-wing mission without a landing unless "
                      "MIS_TKO_LAND_REQ allows it; consider `return_mode` land")
@@ -88,10 +93,6 @@ def _prepare(tour: Tour, frame: LocalFrame, targets: GeoTargets,
     if settings.launch_bearing_deg is None:
         notes.append(f"launch bearing not given: towards the first target "
                      f"({heading_to_bearing_deg(launch_heading):.0f} deg)")
-    if settings.design == "guidance" and settings.autopilot != "ardupilot":
-        notes.append("waypoints placed by geometry: the guidance design predicts ArduPlane's "
-                     "navigation, and PX4's is not modelled")
-        settings = replace(settings, design="geometry")
     return _Prepared(settings, path, at_targets, (home_lat, home_lon), home_m, notes)
 
 
@@ -99,7 +100,7 @@ def _steep_steps(path: FlightPath, targets: GeoTargets, settings: MissionSetting
     """Warnings for altitude changes between targets steeper than the aircraft climbs or
     sinks at its airspeed (TECS_CLMB_MAX, TECS_SINK_MAX): it reaches such a target off its
     altitude."""
-    vehicle = settings.vehicle or ARDUPLANE_DEFAULTS
+    vehicle = settings.vehicle if isinstance(settings.vehicle, VehicleParameters) else ARDUPLANE_DEFAULTS
     airspeed = settings.airspeed_m_s or vehicle.AIRSPEED_CRUISE
     knots_s, knots_alt = path.altitudes_at_s
     steps = np.diff(knots_alt)

@@ -19,8 +19,9 @@ from ..targets import GeoTargets
 from ..targets.actions import check_gimbal_pitch
 from ..targets.model import MAX_ALTITUDE_M
 from ..autopilot.commands import AUTOPILOTS
-from ..autopilot.navigation import CALM, MAX_WIND_M_S, Wind, check_turn_radius, check_wind
-from ..autopilot.parameters import ARDUPLANE_DEFAULTS, VehicleParameters
+from ..autopilot.navigation import (CALM, MAX_WIND_M_S, Airframe, Wind, check_turn_radius,
+                                    check_wind)
+from ..autopilot.parameters import ARDUPLANE_DEFAULTS, PX4_DEFAULTS, PX4Parameters, VehicleParameters
 from ..autopilot.storage import MAVLINK_MAX_ITEMS, capacity
 from .flight_path import TAKEOFF_CLIMB_DEG
 from .guidance import DesignTuning
@@ -78,7 +79,7 @@ class MissionSettings:
     takeoff_pitch_deg: float = TAKEOFF_CLIMB_DEG
     design: str = "geometry"                  # guidance | geometry (see DESIGNS)
     max_miss_m: float = 5.0                   # guidance: the predicted miss every target must hold
-    vehicle: VehicleParameters | None = None  # guidance: the autopilot's parameters (stock if None)
+    vehicle: VehicleParameters | PX4Parameters | None = None  # the autopilot's parameters (stock if None)
     photo: bool = False                       # a picture at every target
     roi: bool = False                         # the camera pointed at every target
     gimbal_pitch_deg: float | None = None     # gimbal pitch for targets without their own
@@ -140,7 +141,7 @@ class MissionSettings:
             raise InputError(f"`loiter_radius_m` must be from the turn radius "
                              f"({rho_m:g} m) to 2,550 m (the most ArduPilot stores), got "
                              f"{self.loiter_radius_m!r}")
-        airspeed = self.airspeed_m_s or (self.vehicle or ARDUPLANE_DEFAULTS).AIRSPEED_CRUISE
+        airspeed = self.airspeed_m_s or self.design_airframe().airspeed_m_s
         check_wind(self.wind, airspeed)
         spread = (max(MIN_WIND_SPREAD_M_S, DEFAULT_WIND_SPREAD * self.wind.speed_m_s)
                   if self.wind_spread_m_s is None else self.wind_spread_m_s)
@@ -148,7 +149,8 @@ class MissionSettings:
             raise InputError(f"the wind spread (`wind_spread_m_s`) must be from 0 to "
                              f"{MAX_WIND_M_S:g} m/s, got {spread!r}")
         check_wind(Wind(self.wind.speed_m_s + spread, self.wind.from_deg), airspeed)
-        if self.vehicle is not None or self.design == "guidance" or self.airspeed_m_s is not None:
+        if self.autopilot == "ardupilot" and (self.vehicle is not None or self.design == "guidance"
+                                              or self.airspeed_m_s is not None):
             check_turn_radius(rho_m, self.vehicle or ARDUPLANE_DEFAULTS, self.airspeed_m_s)
         margin = MODEL_MARGIN_M if self.model_margin_m is None else self.model_margin_m
         if not (math.isfinite(margin) and 0 <= margin <= self.max_miss_m - MIN_DESIGN_LIMIT_M):
@@ -161,6 +163,15 @@ class MissionSettings:
                                  "of degrees")
         return replace(self, return_mode=return_mode, tolerance_m=tolerance, max_items=max_items,
                        wind_spread_m_s=spread, model_margin_m=margin)
+
+    def design_airframe(self) -> Airframe:
+        """The aircraft the guidance design flies: the autopilot's navigation with the
+        vehicle's parameters (a stock vehicle's if None) at the airspeed asked for."""
+        if self.autopilot == "px4":
+            px4 = self.vehicle if isinstance(self.vehicle, PX4Parameters) else PX4_DEFAULTS
+            return Airframe.from_px4_parameters(px4, self.airspeed_m_s)
+        parameters = self.vehicle if isinstance(self.vehicle, VehicleParameters) else ARDUPLANE_DEFAULTS
+        return Airframe.from_parameters(parameters, self.airspeed_m_s)
 
     @property
     def design_limit_m(self) -> float:

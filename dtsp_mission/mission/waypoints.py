@@ -16,8 +16,6 @@ from ..frame import LocalFrame
 from ..targets import GeoTargets
 from ..tour import Tour
 from ..autopilot.commands import Command
-from ..autopilot.navigation import Airframe
-from ..autopilot.parameters import ARDUPLANE_DEFAULTS
 from .discretise import waypoint_s
 from .guidance import GuidanceDesign, design_waypoints
 from .model import FlightPath
@@ -71,10 +69,10 @@ def fit_waypoints(path: FlightPath, rho_m: float, settings: MissionSettings,
 def design_for_guidance(path: FlightPath, tour: Tour, frame: LocalFrame, targets: GeoTargets,
                          settings: MissionSettings, actions: int = 0,
                          progress: Callable[[int, int], None] | None = None) -> GuidanceDesign:
-    """Waypoints for ArduPlane's guidance (:mod:`.guidance`) within the item budget; the
-    lead-out of a landing stays a geometric polyline."""
-    parameters = settings.vehicle or ARDUPLANE_DEFAULTS
-    airframe = Airframe.from_parameters(parameters, settings.airspeed_m_s)
+    """Waypoints for the autopilot's guidance (:mod:`.guidance`, flying
+    :meth:`MissionSettings.design_airframe`) within the item budget; the lead-out of a landing
+    stays a geometric polyline."""
+    airframe = settings.design_airframe()
     tail = guidance_tail(path, tour, settings, actions)
     budget = settings.max_items - fixed_items(settings, actions) - len(tail)
     head = ([(Command.DO_CHANGE_SPEED, (0.0, float(settings.airspeed_m_s), -1.0, 0.0))]

@@ -13,6 +13,7 @@ from dataclasses import replace
 import numpy as np
 import pytest
 
+from dtsp_mission.autopilot import Autopilot, Command
 from dtsp_mission.autopilot.navigation import Airframe, closest_approach_m
 from dtsp_mission.errors import InputError, MissionTooLarge
 from dtsp_mission.frame import LocalFrame
@@ -60,11 +61,22 @@ def test_the_written_mission_flown_again_passes_every_target(designed):
     assert miss.max() <= 6.0, np.sort(miss)[-5:]
 
 
-def test_px4_falls_back_to_the_geometric_design_and_says_so():
-    tour, frame, targets = sparse_site(10)
+def test_a_px4_mission_is_designed_for_px4s_guidance():
+    """PX4 missions get the guidance design too, flying PX4's model (NPFG, its switching 31 m
+    before a waypoint): few items, every target held when the written mission is flown again by
+    the PX4 model, and a landing at the end (PX4's MIS_TKO_LAND_REQ)."""
+    tour, frame, targets = sparse_site(20)
     mission = build_mission(tour, frame, targets, MissionSettings(autopilot="px4", design="guidance"))
-    assert "predicted_miss_m" not in mission.summary
-    assert any("PX4's is not modelled" in note for note in mission.notes)
+    assert mission.guidance is not None and mission.autopilot == Autopilot.PX4
+    assert len(mission.items) <= 1.6 * len(targets) + 6
+    assert mission.items[-1].command == Command.NAV_LAND
+    flight = predict_flight(mission.for_vehicle(), Airframe.from_px4_parameters(), 0.02)
+    start = dict(flight.reached)[0]
+    xy = flight.frame.to_local(targets.latitudes_deg, targets.longitudes_deg)
+    miss = closest_approach_m(flight.track[flight.track[:, 0] >= start, 1:3], xy)
+    assert miss.max() <= mission.guidance.design_limit_m + 0.5, np.sort(miss)[-3:]
+    # the flight the model predicts is no longer than the exact path it was designed from
+    assert mission.guidance.predicted_flight_m <= 1.05 * mission.guidance.planned_flight_m
 
 
 def test_a_budget_below_one_item_per_target_is_refused_with_the_count():
