@@ -17,8 +17,22 @@ from pathlib import Path
 from ..errors import FileAccessError, FileFormatError
 
 
+class _NamedValues:
+    """Parameters by their autopilot's names: what differs between two sets."""
+
+    def differing(self, other: "_NamedValues") -> list[tuple[str, float, float]]:
+        """(name, ours, theirs) of every parameter whose values differ."""
+        return [(f.name, getattr(self, f.name), getattr(other, f.name)) for f in fields(self)
+                if not math.isclose(getattr(self, f.name), getattr(other, f.name),
+                                    rel_tol=1e-6, abs_tol=1e-9)]
+
+    def with_values(self, values: dict[str, float]):
+        """These parameters with every one found in ``values`` (others are ignored)."""
+        return replace(self, **{f.name: values[f.name] for f in fields(self) if f.name in values})
+
+
 @dataclass(frozen=True)
-class VehicleParameters:
+class VehicleParameters(_NamedValues):
     """The navigation parameters of an ArduPlane, by their ArduPilot names (units as there)."""
 
     NAVL1_PERIOD: float = 15.0        # s
@@ -40,12 +54,6 @@ class VehicleParameters:
     def l1_distance_m(self, speed_m_s: float) -> float:
         """ArduPlane's L1 distance at this ground speed."""
         return self.NAVL1_DAMPING * self.NAVL1_PERIOD * speed_m_s / math.pi
-
-    def differing(self, other: "VehicleParameters") -> list[tuple[str, float, float]]:
-        """(name, ours, theirs) of every parameter whose values differ."""
-        return [(f.name, getattr(self, f.name), getattr(other, f.name)) for f in fields(self)
-                if not math.isclose(getattr(self, f.name), getattr(other, f.name),
-                                    rel_tol=1e-6, abs_tol=1e-9)]
 
 
 ARDUPLANE_DEFAULTS = VehicleParameters()
@@ -92,13 +100,17 @@ def parameter_name(param_id: str | bytes) -> str:
 
 
 def parse_parameters(text: str, where: str = "parameters") -> dict[str, float]:
-    """Every ``NAME VALUE`` of a parameter file's text, by name."""
+    """Every ``NAME VALUE`` of a parameter file's text, by name: ArduPilot's and MAVProxy's
+    ``.parm`` lines, or QGroundControl's saved ``.params`` lines (``VEHICLE COMPONENT NAME
+    VALUE TYPE``, tab-separated)."""
     values: dict[str, float] = {}
     for number, line in enumerate(text.splitlines(), 1):
         line = line.split("#", 1)[0].strip()
         if not line:
             continue
         parts = line.replace(",", " ").split()
+        if len(parts) >= 4 and parts[0].isdigit() and parts[1].isdigit():
+            parts = parts[2:4]                  # QGroundControl: vehicle, component, name, value
         if len(parts) < 2:
             raise FileFormatError(f"{where}, line {number}: expected NAME VALUE, got {line!r}")
         try:
@@ -110,7 +122,7 @@ def parse_parameters(text: str, where: str = "parameters") -> dict[str, float]:
 
 def parameters_from(values: dict[str, float], base: VehicleParameters = ARDUPLANE_DEFAULTS) -> VehicleParameters:
     """``base`` with every navigation parameter found in ``values`` (others are ignored)."""
-    return replace(base, **{name: values[name] for name in NAMES if name in values})
+    return base.with_values(values)
 
 
 def read_parameters(path: str | os.PathLike) -> VehicleParameters:
@@ -125,7 +137,7 @@ def read_parameters(path: str | os.PathLike) -> VehicleParameters:
 
 
 @dataclass(frozen=True)
-class PX4Parameters:
+class PX4Parameters(_NamedValues):
     """The fixed-wing navigation parameters of a PX4 (v1.16), by their PX4 names (units as
     there); the defaults are PX4's stock values, as a stock PX4 SITL reports them
     (``tests/data/px4-sitl/*/params.parm``)."""
@@ -165,4 +177,4 @@ def read_px4_parameters(path: str | os.PathLike) -> PX4Parameters:
         if name in values and not (math.isfinite(values[name]) and low <= values[name] <= high):
             raise FileFormatError(f"{path}: {name} {values[name]:g} is out of its range "
                                   f"{low:g} .. {high:g}")
-    return replace(PX4_DEFAULTS, **{name: values[name] for name in PX4_NAMES if name in values})
+    return PX4_DEFAULTS.with_values(values)

@@ -280,15 +280,15 @@ def airframe_from(vehicle_params_file, airspeed_m_s, max_bank_deg, l1_period_s,
               else "stock parameters")
     if autopilot in ("px4", Autopilot.PX4):
         from ..autopilot.navigation import px4_parameters_with
-        from ..autopilot.parameters import PX4_DEFAULTS, read_px4_parameters
-        px4 = read_px4_parameters(vehicle_params_file) if vehicle_params_file else PX4_DEFAULTS
+        from ..autopilot.parameters import PX4_DEFAULTS
+        px4 = designed_for(vehicle_params_file, autopilot) or PX4_DEFAULTS
         px4 = px4_parameters_with(px4, airspeed_m_s, max_bank_deg, l1_period_s, rho_m)
         airframe = Airframe.from_px4_parameters(px4)
         source = (f"PX4 navigation (NPFG): {origin}, trim airspeed {px4.FW_AIRSPD_TRIM:g} m/s "
                   f"({airframe.airspeed_m_s:.1f} m/s true, as PX4 SITL's fixed wing flies it), "
                   f"roll limit {px4.FW_R_LIM:.0f} deg, NPFG_PERIOD {px4.NPFG_PERIOD:g} s, "
                   f"NAV_ACC_RAD {px4.NAV_ACC_RAD:g} m")
-        return airframe, ARDUPLANE_DEFAULTS, source
+        return airframe, px4, source
     parameters = designed_for(vehicle_params_file) or ARDUPLANE_DEFAULTS
     parameters = parameters_with(parameters, airspeed_m_s, max_bank_deg, l1_period_s, rho_m)
     source = (f"ArduPlane navigation: {origin}, cruise {parameters.AIRSPEED_CRUISE:g} m/s, roll "
@@ -297,9 +297,13 @@ def airframe_from(vehicle_params_file, airspeed_m_s, max_bank_deg, l1_period_s,
     return Airframe.from_parameters(parameters), parameters, source
 
 
-def designed_for(vehicle_params_file):
-    """The parameters a mission is designed for: the file's, or None (a stock vehicle's)."""
+def designed_for(vehicle_params_file, autopilot="ardupilot"):
+    """The parameters a mission for ``autopilot`` is designed for: the file's (by ArduPlane's
+    or PX4's names), or None (a stock vehicle's)."""
     if not vehicle_params_file:
         return None
-    from ..autopilot.parameters import read_parameters
+    from ..autopilot.commands import Autopilot
+    from ..autopilot.parameters import read_parameters, read_px4_parameters
+    if autopilot in ("px4", Autopilot.PX4):
+        return read_px4_parameters(vehicle_params_file)
     return read_parameters(vehicle_params_file)

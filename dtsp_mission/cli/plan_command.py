@@ -173,8 +173,9 @@ def plan(targets_file, random_count, area_file, seed, origin, rho_m, airspeed_m_
     _check_writable([*outputs, *([plot_file] if plot_file else [])])
     if algorithm in ("rbta", "auto") and region not in ("bounding", "min-area"):
         region_heading_deg(region)
-    designed_for = designed_for_file(vehicle_params_file)
-    rho, rho_source = turn_radius_from(rho_m, airspeed_m_s, max_bank_deg, designed_for)
+    designed_for = designed_for_file(vehicle_params_file, autopilot)
+    rho, rho_source = turn_radius_from(rho_m, airspeed_m_s, max_bank_deg,
+                                       designed_for if autopilot == "ardupilot" else None)
     targets = _targets(targets_file, random_count, area_file, seed, rho)
     if targets.unused_columns:
         note(f"{targets_file}: columns not used: {', '.join(targets.unused_columns)} (the "

@@ -57,7 +57,7 @@ def upload(mission_file, connection, via, verify, signing_key_file, transfer_tim
     else:
         mission = read_mission(mission_file, format_name)
     run_upload(mission, connection, via, verify, signing_key_file, heartbeat_timeout_s,
-               designed_for(vehicle_params_file), transfer_timeout_s)
+               designed_for(vehicle_params_file, mission.autopilot), transfer_timeout_s)
     console.finish()
 
 

@@ -21,7 +21,7 @@ from __future__ import annotations
 
 import threading
 import time
-from dataclasses import dataclass, field
+from dataclasses import dataclass, field, fields
 
 import numpy as np
 from pymavlink.dialects.v20 import ardupilotmega
@@ -36,7 +36,8 @@ from pymavlink.dialects.v20.common import (MAVLINK_MSG_ID_HOME_POSITION, MAV_CMD
 
 from ..autopilot.navigation import (CALM, MODEL_STEP_S, Airframe, LocalItem, MissionFlight, Wind,
                                     launch_heading_rad, local_items)
-from ..autopilot.parameters import ARDUPLANE_DEFAULTS, NAMES, VehicleParameters, parameter_name
+from ..autopilot.parameters import (ARDUPLANE_DEFAULTS, PX4_DEFAULTS, PX4Parameters, VehicleParameters,
+                                   parameter_name)
 from ..autopilot.storage import MissionStore, stored_item
 from ..frame import LocalFrame
 from ..mavsdk_log import quiet_mavsdk_log
@@ -68,7 +69,8 @@ class VehicleSettings:
     restart_s: float = 1.0            # how long a reboot keeps it silent (wall seconds)
     upload_timeout_s: float = 8.0     # an upload without an item this long is cancelled
                                       # (ArduPilot's MissionItemProtocol: 8 s)
-    parameters: VehicleParameters = ARDUPLANE_DEFAULTS   # what it answers PARAM_REQUEST_READ with
+    #: what it answers PARAM_REQUEST_READ with (by their names; None: its autopilot's stock ones)
+    parameters: VehicleParameters | PX4Parameters | None = None
     wind: Wind = CALM                 # the steady wind it flies in
 
 
@@ -331,19 +333,22 @@ class SimulatedVehicle:
         return False
 
     def _answer_parameter(self, message) -> None:
-        """PARAM_VALUE for a navigation parameter an ArduPilot vehicle has (by name or index);
-        like a real vehicle it stays silent for a name it does not know."""
-        if self.settings.autopilot != Autopilot.ARDUPILOTMEGA:
-            return
+        """PARAM_VALUE for a navigation parameter the vehicle has (by name or index: ArduPlane's
+        or PX4's, as its autopilot); like a real vehicle it stays silent for a name it does not
+        know."""
+        parameters = self.settings.parameters
+        if parameters is None:
+            parameters = PX4_DEFAULTS if self.settings.autopilot == Autopilot.PX4 else ARDUPLANE_DEFAULTS
+        names = [f.name for f in fields(parameters)]
         name = parameter_name(message.param_id)
         if message.param_index >= 0 and not name:
-            name = NAMES[message.param_index] if message.param_index < len(NAMES) else ""
-        if name not in NAMES:
+            name = names[message.param_index] if message.param_index < len(names) else ""
+        if name not in names:
             return
         with self._link_lock:
             self._encoder.srcSystem, self._encoder.srcComponent = 1, 1
-            self._encoder.param_value_send(name.encode(), float(getattr(self.settings.parameters, name)),
-                                           MAV_PARAM_TYPE_REAL32, len(NAMES), NAMES.index(name))
+            self._encoder.param_value_send(name.encode(), float(getattr(parameters, name)),
+                                           MAV_PARAM_TYPE_REAL32, len(names), names.index(name))
 
     # -- the mission ---------------------------------------------------------------------------
 

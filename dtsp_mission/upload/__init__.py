@@ -13,7 +13,8 @@ import time
 from dataclasses import dataclass, replace
 
 from ..autopilot import MAVLINK_MAX_ITEMS, Autopilot
-from ..autopilot.parameters import ARDUPLANE_DEFAULTS, NAMES, VehicleParameters, parameters_from
+from ..autopilot.parameters import (ARDUPLANE_DEFAULTS, NAMES, PX4_DEFAULTS, PX4_NAMES, PX4Parameters,
+                                   VehicleParameters)
 from ..errors import InputError, LinkError
 from ..autopilot.commands import Command
 from ..autopilot.mission import VehicleMission
@@ -72,11 +73,21 @@ WIND_WARNING_DEG = 30.0
 WIND_WAIT_S = 1.5
 
 
+def designed_parameters(mission: VehicleMission,
+                        designed_for: VehicleParameters | PX4Parameters | None = None
+                        ) -> VehicleParameters | PX4Parameters:
+    """The navigation parameters ``mission`` was designed for: ``designed_for`` if it is its
+    autopilot's, else that autopilot's stock values."""
+    if mission.autopilot == Autopilot.PX4:
+        return designed_for if isinstance(designed_for, PX4Parameters) else PX4_DEFAULTS
+    return designed_for if isinstance(designed_for, VehicleParameters) else ARDUPLANE_DEFAULTS
+
+
 def vehicle_warnings(mission: VehicleMission, info: VehicleInfo,
-                     designed_for: VehicleParameters | None = None) -> list[str]:
+                     designed_for: VehicleParameters | PX4Parameters | None = None) -> list[str]:
     """What to tell before an upload: raises :class:`LinkError` if the vehicle runs another
     autopilot than the plan was made for; warns for each navigation parameter that differs
-    from ``designed_for`` (ArduPilot's stock values by default) and for a home far away."""
+    from ``designed_for`` (the autopilot's stock values by default) and for a home far away."""
     if info.autopilot is not None and info.autopilot != int(mission.autopilot) and \
             info.autopilot in _AUTOPILOT_NAMES:
         raise LinkError(f"the plan was made for {_autopilot_name(mission.autopilot)}, but the "
@@ -86,9 +97,9 @@ def vehicle_warnings(mission: VehicleMission, info: VehicleInfo,
     warnings = []
     if not info.checked:
         return ["the vehicle's parameters and home were not checked (this uploader cannot ask)"]
-    if mission.autopilot == Autopilot.ARDUPILOTMEGA and info.parameters:
-        expected = designed_for or ARDUPLANE_DEFAULTS
-        on_vehicle = parameters_from(info.parameters, expected)
+    if info.parameters:
+        expected = designed_parameters(mission, designed_for)
+        on_vehicle = expected.with_values(info.parameters)
         for name, ours, theirs in expected.differing(on_vehicle):
             warnings.append(f"the vehicle's {name} is {theirs:g}, the mission was designed for "
                             f"{ours:g}: it will fly differently than predicted")
@@ -124,7 +135,7 @@ def upload_mission(mission: VehicleMission, connection: str, via: str = "pymavli
                    verify: bool = True, signing_key: bytes | None = None,
                    progress: Progress | None = None,
                    heartbeat_timeout_s: float | None = None,
-                   designed_for: VehicleParameters | None = None,
+                   designed_for: VehicleParameters | PX4Parameters | None = None,
                    timeout_s: float | None = None) -> UploadReport:
     """Upload ``mission`` and, with ``verify``, download it back and compare item by item.
 
@@ -150,9 +161,13 @@ def upload_mission(mission: VehicleMission, connection: str, via: str = "pymavli
                          f"MAVLink addresses at most {MAVLINK_MAX_ITEMS}: nothing was sent")
     started = time.perf_counter()
     with uploader_class(connection, signing_key=signing_key, **options) as uploader:
-        names = NAMES if mission.autopilot == Autopilot.ARDUPILOTMEGA else ()
+        # the navigation parameters by the names of the autopilot the plan is for; a file
+        # that does not say its autopilot is ArduPilot's until the vehicle says otherwise
+        names = (NAMES if mission.autopilot == Autopilot.ARDUPILOTMEGA
+                 else PX4_NAMES if mission.autopilot_stated else ())
         info = uploader.vehicle_info(names, WIND_WAIT_S if mission.design_wind is not None
-                                     and mission.autopilot == Autopilot.ARDUPILOTMEGA else 0.0)
+                                     and mission.autopilot == Autopilot.ARDUPILOTMEGA else 0.0,
+                                     int(mission.autopilot))
         unstated = []
         if not mission.autopilot_stated and info.autopilot in _AUTOPILOT_NAMES:
             # A .waypoints file does not say its autopilot: it is meant for this vehicle's.

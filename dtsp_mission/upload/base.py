@@ -78,10 +78,11 @@ class Uploader:
         raise NotImplementedError
 
     def vehicle_info(self, parameter_names: tuple[str, ...] = (),
-                     wind_wait_s: float = 0.0) -> VehicleInfo:
-        """The vehicle's autopilot, home and the named parameters, as far as this uploader
-        can ask, and its wind estimate if it sends one within ``wind_wait_s`` (the default:
-        nothing is known)."""
+                     wind_wait_s: float = 0.0, names_autopilot: int | None = None) -> VehicleInfo:
+        """The vehicle's autopilot, home and the named parameters -- names of
+        ``names_autopilot`` (MAV_AUTOPILOT; ArduPilot's if None), asked only of a vehicle that
+        runs it -- as far as this uploader can ask, and its wind estimate if it sends one
+        within ``wind_wait_s`` (the default: nothing is known)."""
         return VehicleInfo()
 
     def upload(self, items: list[WireItem], progress: Progress | None = None) -> None:

@@ -165,18 +165,19 @@ class PymavlinkUploader(Uploader):
     # -- what the vehicle is ---------------------------------------------------------------------
 
     def vehicle_info(self, parameter_names: tuple[str, ...] = (),
-                     wind_wait_s: float = 0.0) -> VehicleInfo:
+                     wind_wait_s: float = 0.0, names_autopilot: int | None = None) -> VehicleInfo:
         """Its autopilot (heartbeat), home (HOME_POSITION, asked with MAV_CMD_REQUEST_MESSAGE)
-        and the named parameters (PARAM_REQUEST_READ; ArduPlane's, so of an ArduPilot vehicle
-        only): what is still missing is asked again
+        and the named parameters (PARAM_REQUEST_READ; names of ``names_autopilot``, ArduPilot's
+        if None, so of a vehicle running it only): what is still missing is asked again
         every 0.1 s (or the measured retry timeout, once known; longer after a round without
         any answer), for :data:`VEHICLE_INFO_S` at most (a vehicle stays
         silent for a parameter it does not have).  The first answer measures the link's round
         trip for the transfers that follow.  ArduPilot's WIND (its wind estimate, streamed,
         never asked for) is kept if it comes meanwhile, or within ``wind_wait_s``."""
         system, component = self._target
-        if self._autopilot != MAV_AUTOPILOT_ARDUPILOTMEGA:
-            parameter_names = ()         # ArduPlane's names: another autopilot stays silent
+        if self._autopilot != (MAV_AUTOPILOT_ARDUPILOTMEGA if names_autopilot is None
+                               else names_autopilot):
+            parameter_names = ()         # another autopilot's names: it would stay silent
         timer = self._timer = getattr(self, "_timer", None) or RetransmitTimer()
         values: dict[str, float] = {}
         home = wind = None

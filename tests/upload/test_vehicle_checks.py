@@ -63,6 +63,39 @@ def test_a_parameter_file_as_ardupilot_writes_it(tmp_path):
     assert parameters.ROLL_LIMIT_DEG == ARDUPLANE_DEFAULTS.ROLL_LIMIT_DEG
 
 
+def test_a_parameter_file_as_qgroundcontrol_saves_it(tmp_path):
+    """QGroundControl's saved .params (vehicle, component, name, value, type; tab-separated)
+    reads as a .parm does, for ArduPilot's and PX4's names."""
+    from dtsp_mission.autopilot.parameters import PX4_DEFAULTS, read_px4_parameters
+    path = tmp_path / "vehicle.params"
+    path.write_text("# Onboard parameters for Vehicle 1\n#\n# Stack: PX4 Pro\n#\n"
+                    "# Vehicle-Id Component-Id Name Value Type\n"
+                    "1\t1\tNPFG_PERIOD\t14.000000000000000000\t9\n"
+                    "1\t1\tNAV_ACC_RAD\t25.000000000000000000\t9\n"
+                    "1\t1\tNAVL1_PERIOD\t18.000000000000000000\t9\n"
+                    "1\t1\tSYS_AUTOSTART\t10041\t6\n")
+    px4 = read_px4_parameters(path)
+    assert (px4.NPFG_PERIOD, px4.NAV_ACC_RAD, px4.FW_R_LIM) == (14.0, 25.0, PX4_DEFAULTS.FW_R_LIM)
+    assert read_parameters(path).NAVL1_PERIOD == 18.0
+
+
+def test_a_px4_vehicles_navigation_parameters_are_compared_by_px4s_names(start_vehicle):
+    """A PX4 is asked for its own parameters (NPFG_*, NAV_ACC_RAD, FW_*): the simulated one
+    answers as PX4 does; a tuned one is named, one tuned as designed for is not."""
+    from dtsp_mission.autopilot.parameters import PX4_DEFAULTS
+    px4 = make_mission(6, 5, 80.0, span_m=1000.0, autopilot="px4").for_vehicle()
+    vehicle = start_vehicle(px4, autopilot=Autopilot.PX4)
+    assert upload_mission(px4, f"udpout:127.0.0.1:{vehicle.port}").warnings == ()
+    tuned = replace(PX4_DEFAULTS, NPFG_PERIOD=14.0)
+    vehicle = start_vehicle(px4, autopilot=Autopilot.PX4, parameters=tuned)
+    report = upload_mission(px4, f"udpout:127.0.0.1:{vehicle.port}")
+    assert report.verified and report.warnings == (
+        "the vehicle's NPFG_PERIOD is 14, the mission was designed for 10: it will fly "
+        "differently than predicted",)
+    again = upload_mission(px4, f"udpout:127.0.0.1:{vehicle.port}", designed_for=tuned)
+    assert again.warnings == ()
+
+
 def test_a_px4_plan_is_refused_by_an_ardupilot_vehicle(start_vehicle):
     px4 = make_mission(6, 5, 80.0, span_m=1000.0, autopilot="px4").for_vehicle()
     vehicle = start_vehicle(px4, autopilot=Autopilot.ARDUPILOTMEGA)
