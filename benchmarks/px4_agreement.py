@@ -47,8 +47,9 @@ cases): the SIH aircraft's true airspeed (13.9 m/s at FW_AIRSPD_TRIM 15), its tu
 times the coordinated rate for its bank), its roll response (4.0 rad/s, damping 0.7), its
 take-off (run at 5 m/s^2, climb-out at 10 m/s) and the airspeed's rise to cruise after it
 (time constant 18 s). Not modelled: NPFG's period adaptation (its lower bound, pi NPFG_ROLL_TC
-/ damping times a safety factor, is below the stock period), loiters as PX4 flies them (the
-model flies ArduPlane's), landing approaches. These flights are not lock-stepped: a repeated
+/ damping times a safety factor, is below the stock period), landing approaches. Loiters
+(NAV_LOITER_TIME, radius param3) are NPFG on the circle with its curvature fed forward, as PX4
+flies them, but no recorded PX4 flight has one. These flights are not lock-stepped: a repeated
 real flight differs by a metre or two (the square's corners: 10.7 and 12.3 m median).
 
 Goals (as for ArduPlane): timing within 2 s, track within 3 m (median) and 10 m (max), closest

@@ -207,22 +207,16 @@ def npfg_track_error_bound(af, ground_speed):
 
 
 @numba.njit(**_JIT)
-def _npfg_lateral_accel(st, af, ax, ay, bx, by):
-    """PX4's NPFG for the line through A and B (towards B): lateral acceleration, positive to
-    the left.  The bearing turns from the path's normal (far off it) to its tangent (on it) as
-    the look-ahead angle pi/2 (1 - e)^2 of the track error e normalised by the track error
-    bound; the heading that makes the ground velocity follow the bearing in the wind is
-    tracked with the gain 4 pi damping / period on the airspeed (the most held beyond 90 deg
-    off)."""
-    x, y = st[S_X], st[S_Y]
-    _, _, ground = _ground_velocity(st, af)
-    tx, ty = bx - ax, by - ay
-    length = math.hypot(tx, ty)
-    if length < 1e-6:                       # no line: towards B
-        tx, ty = bx - x, by - y
-        length = max(math.hypot(tx, ty), 1e-9)
-    tx, ty = tx / length, ty / length
-    error = _cross(tx, ty, x - ax, y - ay)  # left of the path: positive
+def _npfg(st, af, tx, ty, error, curvature):
+    """PX4's NPFG for a path through the point nearest the aircraft with unit tangent (tx,
+    ty), the aircraft ``error`` metres to its left, ``curvature`` (1/m, positive turning left):
+    lateral acceleration, positive to the left.  The bearing turns from the path's normal (far
+    off it) to its tangent (on it) as the look-ahead angle pi/2 (1 - e)^2 of the track error e
+    normalised by the track error bound; the heading that makes the ground velocity follow the
+    bearing in the wind is tracked with the gain 4 pi damping / period on the airspeed (the
+    most held beyond 90 deg off); a curved path adds the acceleration that keeps the aircraft
+    on it, ramped in as it comes near."""
+    vx, vy, ground = _ground_velocity(st, af)
     normalized = min(abs(error) / npfg_track_error_bound(af, ground), 1.0)
     look_ahead = 0.5 * math.pi * (normalized - 1.0) * (normalized - 1.0)
     side = -1.0 if error < 0.0 else 1.0
@@ -239,8 +233,52 @@ def _npfg_lateral_accel(st, af, ax, ay, bx, by):
     off = _wrap(math.atan2(heading_y, heading_x) - st[S_HEADING])
     gain = 4.0 * math.pi * af[A_L1_DAMPING] / af[A_L1_PERIOD]
     if math.cos(off) < 0.0:
-        return gain * (airspeed if off > 0.0 else -airspeed)
-    return gain * airspeed * math.sin(off)
+        accel = gain * (airspeed if off > 0.0 else -airspeed)
+    else:
+        accel = gain * airspeed * math.sin(off)
+    if curvature != 0.0:
+        frame_curvature = curvature / max(1.0 - curvature * error, abs(curvature) * 0.1)
+        tangent_speed = max(vx * tx + vy * ty, 0.0)
+        wind_across = _cross(tx, ty, wx, wy)
+        projected = math.sqrt(max(airspeed * airspeed - wind_across * wind_across, 1e-6))
+        ratio = 1.0 + (wx * tx + wy * ty) / projected
+        proximity = math.sin(look_ahead) ** 2
+        accel += airspeed * ratio * frame_curvature * tangent_speed * proximity
+    return accel
+
+
+@numba.njit(**_JIT)
+def _npfg_lateral_accel(st, af, ax, ay, bx, by):
+    """PX4's NPFG (:func:`_npfg`) for the line through A and B, towards B."""
+    x, y = st[S_X], st[S_Y]
+    tx, ty = bx - ax, by - ay
+    length = math.hypot(tx, ty)
+    if length < 1e-6:                       # no line: towards B
+        tx, ty = bx - x, by - y
+        length = max(math.hypot(tx, ty), 1e-9)
+    tx, ty = tx / length, ty / length
+    return _npfg(st, af, tx, ty, _cross(tx, ty, x - ax, y - ay), 0.0)
+
+
+@numba.njit(**_JIT)
+def _npfg_loiter_lateral_accel(st, af, cx, cy, radius, direction):
+    """PX4's NPFG (:func:`_npfg`) for the circle of ``radius`` around (cx, cy), ``direction``
+    +1 clockwise; and whether the aircraft is on it (within a tenth of the track error bound,
+    as PX4 counts a loiter from there)."""
+    rx, ry = st[S_X] - cx, st[S_Y] - cy
+    distance = math.hypot(rx, ry)
+    if distance > 0.1:
+        ux, uy = rx / distance, ry / distance
+    else:
+        ux, uy = math.cos(st[S_HEADING] - math.pi / 2), math.sin(st[S_HEADING] - math.pi / 2)
+    if direction > 0:                       # clockwise: the centre to the right
+        tx, ty, curvature = uy, -ux, -1.0 / radius
+    else:
+        tx, ty, curvature = -uy, ux, 1.0 / radius
+    error = _cross(tx, ty, (distance - radius) * ux, (distance - radius) * uy)
+    _, _, ground = _ground_velocity(st, af)
+    on_circle = abs(distance - radius) < 0.1 * npfg_track_error_bound(af, ground)
+    return _npfg(st, af, tx, ty, error, curvature), on_circle
 
 
 @numba.njit(**_JIT)
@@ -387,7 +425,8 @@ def _step_loiter(st, af, command, position, params, following, reached, counts, 
     with the tangent exit (param4), leave when the ground course points at the next waypoint;
     the next leg starts where it left (from the centre without it).  LOITER_TIME: the same,
     for param1 seconds from the capture, on ArduPlane's own loiter radius (it keeps only the
-    sign of param3, the direction)."""
+    sign of param3, the direction).  PX4 (``A_PX4``) follows the circle with NPFG, and its
+    LOITER_TIME's radius is param3's (NAV_LOITER_RAD if 0)."""
     i = int(st[S_INDEX])
     cx, cy, calt = position[i, 0], position[i, 1], position[i, 2]
     timed = command[i] == NAV_LOITER_TIME
@@ -396,7 +435,12 @@ def _step_loiter(st, af, command, position, params, following, reached, counts, 
     else:
         radius = abs(params[i, 2])
     direction = -1 if params[i, 2] < 0 else 1
-    accel, on_circle = _loiter_lateral_accel(st, af, cx, cy, radius, direction)
+    if af[A_PX4] > 0.0:                     # PX4: NAV_LOITER_TIME's radius is param3's
+        if timed and params[i, 2] != 0.0:
+            radius = abs(params[i, 2])
+        accel, on_circle = _npfg_loiter_lateral_accel(st, af, cx, cy, radius, direction)
+    else:
+        accel, on_circle = _loiter_lateral_accel(st, af, cx, cy, radius, direction)
     _fly(st, af, dt, accel, _toward_alt(st, af, calt, dt), 1.0)
     bearing = math.atan2(st[S_Y] - cy, st[S_X] - cx)
     if st[S_LOITER] == 0.0:

@@ -155,3 +155,21 @@ def test_the_aircraft_turns_at_the_radius_its_airframe_says(airspeed, rho):
     radius = (flown[window:-1] - flown[:-window - 1]) / turned
     assert radius.min() >= rho * (1 - 1e-3)                             # never tighter
     assert np.percentile(radius, 25) <= rho * 1.001                     # mostly at the limit
+
+
+@pytest.mark.parametrize("wind", [CALM, Wind(5.0, 300.0)])
+def test_a_px4_loiter_holds_its_circle_for_its_time(wind):
+    """PX4 flies NAV_LOITER_TIME on the circle of param3's radius (NPFG with the circle's
+    curvature fed forward) for param1 seconds from reaching it: the last circle stays within
+    a few metres of the radius over the ground, in calm air and in wind."""
+    from dtsp_mission.autopilot.navigation import Airframe
+    items = _mission([(300.0, 0.0)])
+    items.insert(3, LocalItem(3, Command.NAV_LOITER_TIME, 900.0, 0.0, 100.0, (120.0, 0.0, 90.0, 0.0)))
+    items = [LocalItem(k, i.command, i.x_m, i.y_m, i.alt_m, i.params) for k, i in enumerate(items)]
+    flight = MissionFlight(items, Airframe.from_px4_parameters(), 0.0, 1, wind)
+    run = flight.run(0.02, 3)
+    times = dict(flight.reached)
+    loop = run.track[run.track[:, 0] > times[3] - 40]               # most of the last circle
+    radius = np.hypot(loop[:, 1] - 900.0, loop[:, 2])
+    assert np.abs(radius - 90.0).max() < (1.0 if wind == CALM else 2.0), (radius.min(), radius.max())
+    assert 120.0 < times[3] - times[2] < 120.0 + 2 * math.pi * 90.0 / 10.0   # its time, from the circle
