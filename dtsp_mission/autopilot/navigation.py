@@ -202,6 +202,30 @@ class AircraftState:
 _NO_POSITION = {Command.NAV_RETURN_TO_LAUNCH}
 
 
+def _overridden(parameters, airspeed_m_s, max_bank_deg, period_s, rho_m, names, radius_bank):
+    """``parameters`` with the fields ``names`` (airspeed, period, roll limit) replaced where
+    given; ``rho_m`` without ``max_bank_deg`` sets the roll limit to ``radius_bank(rho_m,
+    parameters)``.  :class:`InputError` for a value out of range."""
+    airspeed_name, period_name, bank_name = names
+    if airspeed_m_s is not None:
+        if not airspeed_m_s > 0:
+            raise InputError(f"the airspeed must be above 0 m/s, got {airspeed_m_s:g}")
+        parameters = replace(parameters, **{airspeed_name: airspeed_m_s})
+    if period_s is not None:
+        if not period_s > 0:
+            raise InputError(f"the navigation period must be above 0 s, got {period_s:g}")
+        parameters = replace(parameters, **{period_name: period_s})
+    if max_bank_deg is not None or rho_m is not None:
+        if max_bank_deg is None:
+            if not rho_m > 0:
+                raise InputError(f"the turn radius must be above 0 m, got {rho_m:g}")
+            max_bank_deg = radius_bank(rho_m, parameters)
+        if not 0 < max_bank_deg < 90:
+            raise InputError(f"the maximum bank must be between 0 and 90 deg, got {max_bank_deg:g}")
+        parameters = replace(parameters, **{bank_name: max_bank_deg})
+    return parameters
+
+
 def parameters_with(parameters: VehicleParameters, airspeed_m_s: float | None = None,
                     max_bank_deg: float | None = None, l1_period_s: float | None = None,
                     rho_m: float | None = None) -> VehicleParameters:
@@ -209,23 +233,9 @@ def parameters_with(parameters: VehicleParameters, airspeed_m_s: float | None = 
     given; ``rho_m`` without ``max_bank_deg`` sets the roll limit at which this model (turning
     at :data:`SITL_TURN_EFFICIENCY` of the coordinated rate) turns no tighter than ``rho_m``.
     :class:`InputError` for a value out of range."""
-    if airspeed_m_s is not None:
-        if not airspeed_m_s > 0:
-            raise InputError(f"the airspeed must be above 0 m/s, got {airspeed_m_s:g}")
-        parameters = replace(parameters, AIRSPEED_CRUISE=airspeed_m_s)
-    if l1_period_s is not None:
-        if not l1_period_s > 0:
-            raise InputError(f"the L1 period must be above 0 s, got {l1_period_s:g}")
-        parameters = replace(parameters, NAVL1_PERIOD=l1_period_s)
-    if max_bank_deg is not None or rho_m is not None:
-        if max_bank_deg is None:
-            if not rho_m > 0:
-                raise InputError(f"the turn radius must be above 0 m, got {rho_m:g}")
-            max_bank_deg = bank_for_radius_deg(rho_m, parameters.AIRSPEED_CRUISE)
-        if not 0 < max_bank_deg < 90:
-            raise InputError(f"the maximum bank must be between 0 and 90 deg, got {max_bank_deg:g}")
-        parameters = replace(parameters, ROLL_LIMIT_DEG=max_bank_deg)
-    return parameters
+    return _overridden(parameters, airspeed_m_s, max_bank_deg, l1_period_s, rho_m,
+                       ("AIRSPEED_CRUISE", "NAVL1_PERIOD", "ROLL_LIMIT_DEG"),
+                       lambda rho, p: bank_for_radius_deg(rho, p.AIRSPEED_CRUISE))
 
 
 def px4_parameters_with(parameters: PX4Parameters, airspeed_m_s: float | None = None,
@@ -235,24 +245,11 @@ def px4_parameters_with(parameters: PX4Parameters, airspeed_m_s: float | None = 
     replaced where given; ``rho_m`` without ``max_bank_deg`` sets the roll limit at which the
     PX4 model aircraft turns no tighter than ``rho_m``.  :class:`InputError` for a value out of
     range."""
-    if airspeed_m_s is not None:
-        if not airspeed_m_s > 0:
-            raise InputError(f"the airspeed must be above 0 m/s, got {airspeed_m_s:g}")
-        parameters = replace(parameters, FW_AIRSPD_TRIM=airspeed_m_s)
-    if period_s is not None:
-        if not period_s > 0:
-            raise InputError(f"the guidance period must be above 0 s, got {period_s:g}")
-        parameters = replace(parameters, NPFG_PERIOD=period_s)
-    if max_bank_deg is not None or rho_m is not None:
-        if max_bank_deg is None:
-            if not rho_m > 0:
-                raise InputError(f"the turn radius must be above 0 m, got {rho_m:g}")
-            max_bank_deg = bank_for_radius_deg(rho_m, parameters.FW_AIRSPD_TRIM * SIH_AIRSPEED_RATIO,
-                                               SIH_TURN_EFFICIENCY)
-        if not 0 < max_bank_deg < 90:
-            raise InputError(f"the maximum bank must be between 0 and 90 deg, got {max_bank_deg:g}")
-        parameters = replace(parameters, FW_R_LIM=max_bank_deg)
-    return parameters
+    return _overridden(parameters, airspeed_m_s, max_bank_deg, period_s, rho_m,
+                       ("FW_AIRSPD_TRIM", "NPFG_PERIOD", "FW_R_LIM"),
+                       lambda rho, p: bank_for_radius_deg(
+                           rho, min(p.FW_AIRSPD_TRIM, p.FW_AIRSPD_MAX) * SIH_AIRSPEED_RATIO,
+                           SIH_TURN_EFFICIENCY))
 
 
 def check_turn_radius(rho_m: float, parameters: VehicleParameters = ARDUPLANE_DEFAULTS,

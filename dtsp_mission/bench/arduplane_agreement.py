@@ -58,6 +58,20 @@ class Agreement:
     real_length_m: float
     model_length_m: float
 
+    def beyond(self, limits: tuple[float, float, float, float, float]) -> list[str]:
+        """Which of (timing max s, track median m, track max m, closest |diff| median m,
+        closest |diff| max m) this case exceeds, and whether it flew a mission of another
+        length than the real one (more than 2 % off) or timed fewer than 3 items."""
+        fields = ("timing_max_s", "track_median_m", "track_max_m", "approach_median_m",
+                  "approach_max_m")
+        found = [f"{name} {getattr(self, name):.2f} > {limit}"
+                 for name, limit in zip(fields, limits) if getattr(self, name) > limit]
+        if abs(self.model_length_m - self.real_length_m) > 0.02 * self.real_length_m:
+            found.append(f"flown {self.model_length_m:.0f} m against {self.real_length_m:.0f} m")
+        if self.items_timed < 3:
+            found.append(f"only {self.items_timed} items timed")
+        return found
+
     def missed_goals(self) -> list[str]:
         """The simulator issue's goals this case misses (:data:`GOALS`)."""
         return [name for name, (field, limit) in GOALS.items() if getattr(self, field) > limit]
@@ -116,6 +130,40 @@ def _closest_while_current(track: np.ndarray, reached: dict[int, float], seq: in
     return float(closest_approach_m(track[window, 1:3], point[None, :])[0])
 
 
+def timed_and_tracked(folder: Path, frame: LocalFrame, model: np.ndarray,
+                      model_reached: dict[int, float], real_reached: dict[int, float],
+                      start_real: float, start_model: float, first_timed: int):
+    """What the real and the model's flights share: the items both reached from
+    ``first_timed`` on, the |difference| of each one's reach time after the start (the model's
+    scaled to the real flight's duration), the real track (``track.csv``) and the model's over
+    the same span, and the distance of each real position from the model's track."""
+    common = sorted(seq for seq in real_reached if seq in model_reached and seq >= first_timed)
+    end = common[-1]
+    scale = (real_reached[end] - start_real) / max(model_reached[end] - start_model, 1e-9)
+    timing = np.array([abs((model_reached[q] - start_model) * scale - (real_reached[q] - start_real))
+                       for q in common])
+    rows = _rows(folder / "track.csv")
+    real_t = np.array([float(r["time_s"]) for r in rows])
+    real_xy = frame.to_local(np.array([float(r["lat"]) for r in rows]),
+                             np.array([float(r["lon"]) for r in rows]))
+    real_xy = real_xy[(real_t >= start_real) & (real_t <= real_reached[end])]
+    model_xy = model[(model[:, 0] >= start_model) & (model[:, 0] <= model_reached[end]), 1:3]
+    return common, timing, real_xy, model_xy, closest_approach_m(model_xy, real_xy)
+
+
+def agreement(name: str, common: list[int], timing: np.ndarray, real_xy: np.ndarray,
+              model_xy: np.ndarray, track: np.ndarray, real_closest: np.ndarray,
+              model_closest: np.ndarray) -> Agreement:
+    """The figures of one case from what :func:`timed_and_tracked` measured and the real and
+    the model's closest approaches."""
+    difference = np.abs(model_closest - real_closest)
+    return Agreement(name, len(common), float(np.median(timing)), float(timing.max()),
+                     float(np.median(track)), float(np.percentile(track, 95)), float(track.max()),
+                     len(real_closest), float(np.median(difference)), float(difference.max()),
+                     float(np.median(real_closest)), float(np.median(model_closest)),
+                     _length(real_xy), _length(model_xy))
+
+
 def compare_case(folder: str | Path, airframe: Airframe | None = None) -> Agreement:
     """The model against the recorded flight in ``folder``."""
     folder = Path(folder)
@@ -127,21 +175,9 @@ def compare_case(folder: str | Path, airframe: Airframe | None = None) -> Agreem
     # the take-off's reach (seq 1), or where a recording lost it, the first item reached after it
     start_real = real_reached.get(1, real_reached[min(real_reached)])
     start_model = model_reached.get(1, 0.0)
-    common = sorted(seq for seq in real_reached if seq in model_reached and seq > 1)
+    common, timing, real_xy, model_xy, track = timed_and_tracked(
+        folder, frame, model, model_reached, real_reached, start_real, start_model, 2)
     end = common[-1]
-    scale = (real_reached[end] - start_real) / max(model_reached[end] - start_model, 1e-9)
-    timing = np.array([abs((model_reached[q] - start_model) * scale - (real_reached[q] - start_real))
-                       for q in common])
-
-    rows = _rows(folder / "track.csv")
-    real_t = np.array([float(r["time_s"]) for r in rows])
-    real_xy = frame.to_local(np.array([float(r["lat"]) for r in rows]),
-                             np.array([float(r["lon"]) for r in rows]))
-    span = (real_t >= start_real) & (real_t <= real_reached[end])
-    real_xy = real_xy[span]
-    model_span = (model[:, 0] >= start_model) & (model[:, 0] <= model_reached[end])
-    model_xy = model[model_span, 1:3]
-    track = closest_approach_m(model_xy, real_xy)
 
     after_takeoff = model[:, 0] >= start_model
     if (folder / "misses.csv").exists():       # targets: the whole track after take-off
@@ -158,13 +194,8 @@ def compare_case(folder: str | Path, airframe: Airframe | None = None) -> Agreem
                             np.array([float(r["lon"]) for r in points]))
         model_closest = np.array([_closest_while_current(model, model_reached, int(r["seq"]), p)
                                   for r, p in zip(points, xy)])
-    difference = np.abs(model_closest - real_closest)
-
-    return Agreement(folder.name, len(common), float(np.median(timing)), float(timing.max()),
-                     float(np.median(track)), float(np.percentile(track, 95)), float(track.max()),
-                     len(points), float(np.median(difference)), float(difference.max()),
-                     float(np.median(real_closest)), float(np.median(model_closest)),
-                     _length(real_xy), _length(model_xy))
+    return agreement(folder.name, common, timing, real_xy, model_xy, track, real_closest,
+                     model_closest)
 
 
 def cases(root: str | Path) -> list[Path]:

@@ -23,7 +23,7 @@ from ..autopilot.navigation import MODEL_STEP_S, Airframe, closest_approach_m
 from ..autopilot.parameters import read_px4_parameters
 from ..export import read_mission
 from ..sim.predict import predict_flight
-from .arduplane_agreement import RECORDED_AFTER_S, Agreement, _length, _rows
+from .arduplane_agreement import RECORDED_AFTER_S, Agreement, _rows, agreement, timed_and_tracked
 
 
 def compare_px4_case(folder: str | Path, airframe: Airframe | None = None,
@@ -42,19 +42,9 @@ def compare_px4_case(folder: str | Path, airframe: Airframe | None = None,
     # the take-off's reach (seq 0), or where PX4 did not report it, the first item after it
     start_real = real_reached.get(0, real_reached[min(real_reached)])
     start_model = model_reached.get(0, 0.0)
-    common = sorted(seq for seq in real_reached if seq in model_reached and seq > 0)
+    common, timing, real_xy, model_xy, track = timed_and_tracked(
+        folder, frame, model, model_reached, real_reached, start_real, start_model, 1)
     end = common[-1]
-    scale = (real_reached[end] - start_real) / max(model_reached[end] - start_model, 1e-9)
-    timing = np.array([abs((model_reached[q] - start_model) * scale - (real_reached[q] - start_real))
-                       for q in common])
-
-    rows = _rows(folder / "track.csv")
-    real_t = np.array([float(r["time_s"]) for r in rows])
-    real_xy = frame.to_local(np.array([float(r["lat"]) for r in rows]),
-                             np.array([float(r["lon"]) for r in rows]))
-    real_xy = real_xy[(real_t >= start_real) & (real_t <= real_reached[end])]
-    model_xy = model[(model[:, 0] >= start_model) & (model[:, 0] <= model_reached[end]), 1:3]
-    track = closest_approach_m(model_xy, real_xy)
 
     after_takeoff = model[model[:, 0] >= start_model, 1:3]
     if (folder / "misses.csv").exists():       # targets
@@ -67,9 +57,5 @@ def compare_px4_case(folder: str | Path, airframe: Airframe | None = None,
     xy = frame.to_local(np.array([float(r["lat"]) for r in points]),
                         np.array([float(r["lon"]) for r in points]))
     model_closest = closest_approach_m(after_takeoff, xy)
-    difference = np.abs(model_closest - real_closest)
-    return Agreement(folder.name, len(common), float(np.median(timing)), float(timing.max()),
-                     float(np.median(track)), float(np.percentile(track, 95)), float(track.max()),
-                     len(points), float(np.median(difference)), float(difference.max()),
-                     float(np.median(real_closest)), float(np.median(model_closest)),
-                     _length(real_xy), _length(model_xy))
+    return agreement(folder.name, common, timing, real_xy, model_xy, track, real_closest,
+                     model_closest)

@@ -71,17 +71,8 @@ def test_every_recorded_case_has_limits(group):
 
 @pytest.mark.parametrize("group,case", CASES)
 def test_the_model_flies_like_the_recorded_arduplane(group, case):
-    result = compare_case(DATA / group / case)
-    timing, track_median, track_max, closest_median, closest_max = LIMITS[group][case]
-    print(result)
-    assert result.items_timed >= 3
-    assert result.timing_max_s <= timing
-    assert result.track_median_m <= track_median
-    assert result.track_max_m <= track_max
-    assert result.approach_median_m <= closest_median
-    assert result.approach_max_m <= closest_max
-    # the model flies the whole mission, about as far as the real aircraft did
-    assert result.model_length_m == pytest.approx(result.real_length_m, rel=0.02)
+    # within today's figures, and the whole mission flown, about as far as the real aircraft
+    assert compare_case(DATA / group / case).beyond(LIMITS[group][case]) == []
 
 
 def test_the_model_counts_the_targets_a_real_arduplane_missed_in_wind_and_tuned():

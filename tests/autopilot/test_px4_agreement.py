@@ -37,16 +37,13 @@ def test_every_recorded_px4_flight_has_limits():
 
 @pytest.mark.parametrize("case", sorted(LIMITS))
 def test_the_model_flies_like_the_recorded_px4(case):
-    result = compare_px4_case(DATA / case)
-    timing, track_median, track_max, closest_median, closest_max = LIMITS[case]
-    print(result)
-    assert result.items_timed >= 3
-    assert result.timing_max_s <= timing
-    assert result.track_median_m <= track_median
-    assert result.track_max_m <= track_max
-    assert result.approach_median_m <= closest_median
-    assert result.approach_max_m <= closest_max
-    assert result.model_length_m == pytest.approx(result.real_length_m, rel=0.02)
+    # within today's figures, and the whole mission flown, about as far as the real aircraft
+    assert compare_px4_case(DATA / case).beyond(LIMITS[case]) == []
+
+
+def test_a_case_beyond_its_limits_is_named():
+    found = compare_px4_case(DATA / "square").beyond((0.1, 0.1, 100.0, 0.1, 100.0))
+    assert [f.split()[0] for f in found] == ["timing_max_s", "track_median_m", "approach_median_m"]
 
 
 def test_the_model_switches_waypoints_where_px4_does():
