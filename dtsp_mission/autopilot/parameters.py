@@ -178,3 +178,12 @@ def read_px4_parameters(path: str | os.PathLike) -> PX4Parameters:
             raise FileFormatError(f"{path}: {name} {values[name]:g} is out of its range "
                                   f"{low:g} .. {high:g}")
     return PX4_DEFAULTS.with_values(values)
+
+
+def parameters_of(autopilot, given: VehicleParameters | PX4Parameters | None = None
+                  ) -> VehicleParameters | PX4Parameters:
+    """The navigation parameters of a vehicle running ``autopilot`` ("px4" or MAV_AUTOPILOT
+    12 for PX4, else ArduPilot): ``given`` if it is that autopilot's set, else its stock values."""
+    if autopilot == "px4" or autopilot == 12:            # MAV_AUTOPILOT_PX4
+        return given if isinstance(given, PX4Parameters) else PX4_DEFAULTS
+    return given if isinstance(given, VehicleParameters) else ARDUPLANE_DEFAULTS

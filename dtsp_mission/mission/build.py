@@ -26,7 +26,7 @@ from ..targets.model import target_name
 from ..tour import Tour
 from ..vehicle import bearing_to_heading_rad, heading_to_bearing_deg
 from ..autopilot.commands import AUTOPILOTS, Command
-from ..autopilot.parameters import ARDUPLANE_DEFAULTS, PX4_DEFAULTS, PX4Parameters, VehicleParameters
+from ..autopilot.parameters import parameters_of
 from . import actions as action_items
 from .flight_path import climb_distance_m, plan_flight_path
 from .items import mission_items
@@ -63,7 +63,7 @@ def _prepare(tour: Tour, frame: LocalFrame, targets: GeoTargets,
         frame.check_extent(home_lat, home_lon, "targets and home")
     home_m = frame.to_local(home_lat, home_lon)[0]
     if settings.autopilot == "px4" and settings.airspeed_m_s is not None:
-        px4 = settings.vehicle if isinstance(settings.vehicle, PX4Parameters) else PX4_DEFAULTS
+        px4 = parameters_of("px4", settings.vehicle)
         if settings.airspeed_m_s > px4.FW_AIRSPD_MAX:
             notes.append(f"PX4 flies no faster than FW_AIRSPD_MAX ({px4.FW_AIRSPD_MAX:g} m/s): "
                          f"asked {settings.airspeed_m_s:g} m/s, the mission is designed at that")
@@ -100,7 +100,7 @@ def _steep_steps(path: FlightPath, targets: GeoTargets, settings: MissionSetting
     """Warnings for altitude changes between targets steeper than the aircraft climbs or
     sinks at its airspeed (TECS_CLMB_MAX, TECS_SINK_MAX): it reaches such a target off its
     altitude."""
-    vehicle = settings.vehicle if isinstance(settings.vehicle, VehicleParameters) else ARDUPLANE_DEFAULTS
+    vehicle = parameters_of("ardupilot", settings.vehicle)
     airspeed = settings.airspeed_m_s or vehicle.AIRSPEED_CRUISE
     knots_s, knots_alt = path.altitudes_at_s
     steps = np.diff(knots_alt)

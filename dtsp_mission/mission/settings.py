@@ -21,7 +21,7 @@ from ..targets.model import MAX_ALTITUDE_M
 from ..autopilot.commands import AUTOPILOTS
 from ..autopilot.navigation import (CALM, MAX_WIND_M_S, Airframe, Wind, check_turn_radius,
                                     check_wind)
-from ..autopilot.parameters import ARDUPLANE_DEFAULTS, PX4_DEFAULTS, PX4Parameters, VehicleParameters
+from ..autopilot.parameters import ARDUPLANE_DEFAULTS, PX4Parameters, VehicleParameters, parameters_of
 from ..autopilot.storage import MAVLINK_MAX_ITEMS, capacity
 from .flight_path import TAKEOFF_CLIMB_DEG
 from .guidance import DesignTuning
@@ -167,10 +167,9 @@ class MissionSettings:
     def design_airframe(self) -> Airframe:
         """The aircraft the guidance design flies: the autopilot's navigation with the
         vehicle's parameters (a stock vehicle's if None) at the airspeed asked for."""
-        if self.autopilot == "px4":
-            px4 = self.vehicle if isinstance(self.vehicle, PX4Parameters) else PX4_DEFAULTS
-            return Airframe.from_px4_parameters(px4, self.airspeed_m_s)
-        parameters = self.vehicle if isinstance(self.vehicle, VehicleParameters) else ARDUPLANE_DEFAULTS
+        parameters = parameters_of(self.autopilot, self.vehicle)
+        if isinstance(parameters, PX4Parameters):
+            return Airframe.from_px4_parameters(parameters, self.airspeed_m_s)
         return Airframe.from_parameters(parameters, self.airspeed_m_s)
 
     @property

@@ -36,8 +36,7 @@ from pymavlink.dialects.v20.common import (MAVLINK_MSG_ID_HOME_POSITION, MAV_CMD
 
 from ..autopilot.navigation import (CALM, MODEL_STEP_S, Airframe, LocalItem, MissionFlight, Wind,
                                     launch_heading_rad, local_items)
-from ..autopilot.parameters import (ARDUPLANE_DEFAULTS, PX4_DEFAULTS, PX4Parameters, VehicleParameters,
-                                   parameter_name)
+from ..autopilot.parameters import PX4Parameters, VehicleParameters, parameter_name, parameters_of
 from ..autopilot.storage import MissionStore, stored_item
 from ..frame import LocalFrame
 from ..mavsdk_log import quiet_mavsdk_log
@@ -336,9 +335,7 @@ class SimulatedVehicle:
         """PARAM_VALUE for a navigation parameter the vehicle has (by name or index: ArduPlane's
         or PX4's, as its autopilot); like a real vehicle it stays silent for a name it does not
         know."""
-        parameters = self.settings.parameters
-        if parameters is None:
-            parameters = PX4_DEFAULTS if self.settings.autopilot == Autopilot.PX4 else ARDUPLANE_DEFAULTS
+        parameters = parameters_of(self.settings.autopilot, self.settings.parameters)
         names = [f.name for f in fields(parameters)]
         name = parameter_name(message.param_id)
         if message.param_index >= 0 and not name:

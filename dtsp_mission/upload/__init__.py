@@ -13,8 +13,7 @@ import time
 from dataclasses import dataclass, replace
 
 from ..autopilot import MAVLINK_MAX_ITEMS, Autopilot
-from ..autopilot.parameters import (ARDUPLANE_DEFAULTS, NAMES, PX4_DEFAULTS, PX4_NAMES, PX4Parameters,
-                                   VehicleParameters)
+from ..autopilot.parameters import NAMES, PX4_NAMES, PX4Parameters, VehicleParameters, parameters_of
 from ..errors import InputError, LinkError
 from ..autopilot.commands import Command
 from ..autopilot.mission import VehicleMission
@@ -78,9 +77,7 @@ def designed_parameters(mission: VehicleMission,
                         ) -> VehicleParameters | PX4Parameters:
     """The navigation parameters ``mission`` was designed for: ``designed_for`` if it is its
     autopilot's, else that autopilot's stock values."""
-    if mission.autopilot == Autopilot.PX4:
-        return designed_for if isinstance(designed_for, PX4Parameters) else PX4_DEFAULTS
-    return designed_for if isinstance(designed_for, VehicleParameters) else ARDUPLANE_DEFAULTS
+    return parameters_of(mission.autopilot, designed_for)
 
 
 def vehicle_warnings(mission: VehicleMission, info: VehicleInfo,
