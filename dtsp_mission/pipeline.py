@@ -225,8 +225,8 @@ def _design_mission(request: PlanRequest, result: PlanResult,
     """The mission stage: build, widen the turns for the guidance, split where needed."""
     settings, frame, geodetic, tour = request.settings, result.frame, result.geodetic, result.tour
     endurance_s = request.endurance_s
-    # at most: the radius asked, then wider, then the best again with revisits
-    designs = 2 + len(settings.tuning.guidance_margins)
+    # at most: the radius asked, then wider
+    designs = 1 + len(settings.tuning.guidance_margins)
 
     def design_step(k: int) -> Callable[[int, int], None]:
         """Progress of the k-th design, as its share of all the designs' flights."""

@@ -7,7 +7,7 @@ import numpy as np
 import pytest
 
 from dtsp_mission.errors import InputError, MissionTooLarge
-from dtsp_mission.mission import MissionSettings
+from dtsp_mission.mission import DesignTuning, MissionSettings
 from dtsp_mission.mission.widening import targets_beyond
 from dtsp_mission.pipeline import PlanRequest, run_plan
 from dtsp_mission.targets.model import local_targets
@@ -56,7 +56,9 @@ def test_sorties_are_planned_with_wider_turns_where_the_guidance_needs_them():
     frame = LocalFrame(46.8, 6.95)
     targets = local_targets(points).to_geodetic(frame)
     tour = tour_through_poses(points, np.arange(len(points)), headings, 80.0)
-    settings = MissionSettings(design="guidance", airspeed_m_s=22.0, max_items=40)
+    # without second passes, which hold these sorties at rho 80
+    settings = MissionSettings(design="guidance", airspeed_m_s=22.0, max_items=40,
+                               tuning=DesignTuning(revisits=False))
     home = np.array([160.0, 160.0])
     kept = split_into_sorties(tour, frame, targets, settings, home)
     widened = split_into_sorties(tour, frame, targets, settings, home, None,

@@ -36,13 +36,17 @@ checked against recorded ArduPlane flights) and repairing what it misses:
    random placements of them within ``local_spread_m`` (none by default); the change is kept only if the mission flown
    on from the checkpoint costs less.  Up to ``refine_passes`` passes, each ending with the whole mission flown afresh;
    the design returned is the best of those fresh flights;
-8. with ``revisits`` (the wider-turn stage asks for them when its best design still leaves
-   targets beyond): each target still beyond is passed a second time later in the mission --
-   a waypoint over it (its altitude, its acceptance radius) where it lengthens the straight
-   legs least, at least ``revisit_apart`` waypoints from its own -- and the local repair runs
-   again (a revisit's waypoint is moved for its target like the target's own); up to
-   ``revisit_rounds`` rounds, each kept only if the robust cost falls.  A target's miss is the
-   closest of its passes.
+8. with ``revisits`` (the default): each target still beyond is passed a second time later in
+   the mission -- a waypoint over it (its altitude, its acceptance radius) where it lengthens
+   the straight legs least, at least ``revisit_apart`` waypoints from any other pass of it --
+   and the local repair runs again (a revisit's waypoint is moved for its target like the
+   target's own); up to ``revisit_rounds`` rounds, each kept only if the robust cost falls.
+   Targets still beyond then get *detours*: a lead-in waypoint ``revisit_lead_l1`` L1 distances
+   before the target (a straight the guidance settles on), the target, and a rejoin waypoint as
+   far before the next waypoint of the leg the detour leaves (so that waypoint is approached as
+   before); up to ``detour_rounds`` rounds, kept likewise.  A target's miss is the closest of
+   its passes.  Only if targets stay beyond does the wider-turn stage plan the tour again
+   (:mod:`.widening`).
 
 The rounds 2-5 (at the coarser ``prediction_step_s``) hold the targets within ``max_miss_m -
 PREDICTION_MARGIN_M``; the verifying flight and the local repair within ``max_miss_m -
@@ -148,17 +152,32 @@ class DesignTuning:
     #: The wider turn radii (times the one asked for) the whole tour is planned again with,
     #: in turn, when the design at the radius asked for does not hold every target.
     guidance_margins: tuple[float, ...] = (1.3, 1.6)
-    #: Targets the local repair leaves beyond are passed again later in the mission: one
-    #: waypoint over each (its own acceptance radius), inserted where it lengthens the flight
-    #: least (the straight-line detour, plus ``revisit_turn_m`` per radian turned at it), at
-    #: least ``revisit_apart`` waypoints from the target's own; then the local repair once more.
-    revisits: bool = False
-    #: ... and the wider turns (:func:`~dtsp_mission.mission.widening.with_turn_margin`) end
-    #: with the best design made again with revisits when it still leaves targets beyond.
-    revisit_last: bool = True
+    #: ... also when the design holds every target but only by passing some twice (revisits,
+    #: detours), if the wider tour is shorter than that design's predicted flight.  Measured
+    #: (docs/design-time.md, one core) on the bundled site and the uniform 100-400, clustered
+    #: 100/400 and dense 100/200 sites: shorter flights on two of eight (dense 100: 19.49 ->
+    #: 18.81 km, clustered 400: 95.54 -> 92.48 km) for 1.1-2.1 times the design time elsewhere
+    #: (bundled 43 -> 67 s, same flight).  Off by default: hold targets locally first.
+    widen_after_revisits: bool = False
+    #: Targets the local repair leaves beyond are passed again later in the mission, before
+    #: any wider tour is tried: one waypoint over each (its own acceptance radius), inserted
+    #: where it lengthens the flight least (the straight-line detour, plus ``revisit_turn_m``
+    #: per radian turned at it), at least ``revisit_apart`` waypoints from any other pass of
+    #: it; then the local repair once more; up to ``revisit_rounds`` rounds while they help.
+    #: Measured on the bundled site at rho 80: 10 targets beyond -> 3 (24.76 -> 27.25 km).
+    revisits: bool = True
     revisit_turn_m: float = 80.0
     revisit_apart: int = 4
     revisit_rounds: int = 3
+    #: Targets the plain revisits leave beyond get a *detour*: a lead-in waypoint this many L1
+    #: distances before the target (in one of ``revisit_directions`` directions), the target,
+    #: and a rejoin waypoint as far before the next waypoint of the leg it leaves; up to
+    #: ``detour_rounds`` rounds while they help.  Measured on the bundled site at rho 80: the
+    #: 3 targets the revisits left beyond -> 0 (27.25 -> 32.01 km); with a lead-in of 1.2 L1,
+    #: 1 left beyond (30.72 km).
+    revisit_lead_l1: float = 2.0
+    revisit_directions: int = 16
+    detour_rounds: int = 2
 
 
 def _shaping_gap(s_wp: list[float], k: int, lookback_m: float,
@@ -535,36 +554,71 @@ def _refine(aim: np.ndarray, target_of: list[int], items: list[LocalItem], seqs:
     return best[0], best[1], best[2], flights
 
 
+def _turn_rad(into: np.ndarray, out: np.ndarray) -> float:
+    """The heading change from direction ``into`` to ``out`` (0 to pi)."""
+    return abs(math.atan2(into[0] * out[1] - into[1] * out[0], float(into @ out)))
+
+
 def _with_revisits(s_wp: list[float], target_of: list[int], aim: np.ndarray,
                    targets_m: np.ndarray, beyond: list[int], tuning: DesignTuning,
-                   stored: Callable[[np.ndarray], np.ndarray],
-                   end_s_m: float = math.inf) -> tuple[list[float], list[int], np.ndarray]:
-    """The waypoints with one more over each of ``beyond`` (placed ``stored``, as the vehicle
-    keeps it), each where it lengthens the straight legs least (turns at it weighed by
-    ``revisit_turn_m`` per radian), at least ``revisit_apart`` waypoints from the target's own."""
+                   stored: Callable[[np.ndarray], np.ndarray], end_s_m: float = math.inf,
+                   lead_m: float = 0.0) -> tuple[list[float], list[int], np.ndarray]:
+    """The waypoints with one more pass over each of ``beyond`` (its waypoint placed ``stored``,
+    as the vehicle keeps it), on the leg a -> b of the mission where it costs least, at least
+    ``revisit_apart`` waypoints from any other pass of the target and before ``end_s_m``.
+
+    With ``lead_m`` 0 the pass is one waypoint between a and b (cost: the longer straight legs
+    plus ``revisit_turn_m`` per radian turned at it).  With ``lead_m`` > 0 it is a *detour*: a
+    lead-in waypoint ``lead_m`` before the target, in one of ``revisit_directions`` directions
+    (a straight the guidance settles on, whatever the turn onto it), the target, and a rejoin
+    waypoint on the leg ``lead_m`` before b, so that b is approached as before (cost: the
+    detour's length plus ``revisit_turn_m`` per radian of its four turns).  Either way the
+    flight up to a does not change."""
     s_wp, target_of, points = list(s_wp), list(target_of), list(np.asarray(aim))
+    angles = 2.0 * math.pi * np.arange(tuning.revisit_directions) / tuning.revisit_directions
+    directions = np.column_stack([np.cos(angles), np.sin(angles)])
     for t in beyond:
-        own = target_of.index(t)
         here = stored(np.asarray(targets_m[t], dtype=float)[None])[0]
+        leads = stored(here - lead_m * directions) if lead_m > 0 else None
+        passes = [k for k, marker in enumerate(target_of) if marker == t or revisited(marker) == t]
         best, best_cost = None, math.inf
         for k in range(len(points) - 1):
-            if (abs(k - own) < tuning.revisit_apart or abs(k + 1 - own) < tuning.revisit_apart
-                    or s_wp[k] >= end_s_m - 1e-9):
+            if (s_wp[k] >= end_s_m - 1e-9
+                    or any(abs(k - p) < tuning.revisit_apart or abs(k + 1 - p) < tuning.revisit_apart
+                           for p in passes)):
                 continue
             a, b = points[k], points[k + 1]
-            into, out = here - a, b - here
-            la, lb = float(np.hypot(*into)), float(np.hypot(*out))
-            if la < 1e-6 or lb < 1e-6:
+            leg = b - a
+            length = float(np.hypot(*leg))
+            if lead_m <= 0:
+                into, out = here - a, b - here
+                la, lb = float(np.hypot(*into)), float(np.hypot(*out))
+                if la < 1e-6 or lb < 1e-6:
+                    continue
+                cost = la + lb - length + tuning.revisit_turn_m * _turn_rad(into, out)
+                if cost < best_cost:
+                    best, best_cost = (k, [here]), cost
                 continue
-            turn = abs(math.atan2(into[0] * out[1] - into[1] * out[0], float(into @ out)))
-            cost = la + lb - float(np.hypot(*(b - a))) + tuning.revisit_turn_m * turn
-            if cost < best_cost:
-                best, best_cost = k, cost
+            if length < 2.0 * lead_m or target_of[k + 1] <= REVISIT:
+                continue                # no room to rejoin, or b is itself a revisit
+            rejoin = b - lead_m * leg / length
+            for lead, direction in zip(leads, directions):
+                into, out = lead - a, rejoin - here
+                la, lb = float(np.hypot(*into)), float(np.hypot(*out))
+                if la < 1e-6 or lb < 1e-6:
+                    continue
+                turned = (_turn_rad(leg, into) + _turn_rad(into, direction)
+                          + _turn_rad(direction, out) + _turn_rad(out, leg))
+                cost = la + 2.0 * lead_m + lb - length + tuning.revisit_turn_m * turned
+                if cost < best_cost:
+                    best, best_cost = (k, [lead, here, stored(rejoin[None])[0]]), cost
         if best is None:
             continue
-        s_wp.insert(best + 1, s_wp[best])
-        target_of.insert(best + 1, REVISIT - t)
-        points.insert(best + 1, here)
+        k, inserted = best
+        s_wp[k + 1:k + 1] = [s_wp[k]] * len(inserted)
+        target_of[k + 1:k + 1] = ([REVISIT - t] if len(inserted) == 1
+                                  else [-1, REVISIT - t, -1])   # lead-in and rejoin shape it
+        points[k + 1:k + 1] = inserted
     return s_wp, target_of, np.array(points)
 
 
@@ -700,14 +754,21 @@ def design_waypoints(path: FlightPath, targets_m: np.ndarray, altitudes_m: np.nd
                                        spread_margin_m, tuning)
     flights += flown
     s_final, target_final = design.s_m, list(best.target_of)
-    for _ in range(tuning.revisit_rounds if tuning.revisits else 0):
+    # Targets still beyond: passed again (plain revisits while they help), then by detours.
+    lead_m = tuning.revisit_lead_l1 * airframe.l1_distance_m(airframe.airspeed_m_s)
+    kinds = ([0.0] * tuning.revisit_rounds + [lead_m] * tuning.detour_rounds
+             if tuning.revisits else [])
+    failed = None
+    for kind in kinds:
+        if kind == failed:
+            continue
         beyond = [int(t) for t in np.flatnonzero(miss > verify_miss_m)]
-        room = budget - len(target_final)
+        room = (budget - len(target_final)) // (1 if kind == 0.0 else 3)
         if not beyond or room <= 0:
             break
         s_new, target_new, aim_new = _with_revisits(list(s_final), list(target_final), aim,
                                                     targets_m, beyond[:room], tuning, stored,
-                                                    path.tour_end_s_m)
+                                                    path.tour_end_s_m, kind)
         items, seqs = _local_items(takeoff, takeoff_alt, head_items, aim_new - home,
                                    waypoint_altitudes_m(path, s_new, target_new), target_new,
                                    target_acceptance_m, loiters)
@@ -716,7 +777,8 @@ def design_waypoints(path: FlightPath, targets_m: np.ndarray, altitudes_m: np.nd
                                                spread_margin_m, tuning)
         flights += flown2
         if not (_Trial.cost_of(miss2, verify_miss_m).sum() < _Trial.cost_of(miss, verify_miss_m).sum()):
-            break
+            failed = kind
+            continue
         s_final, target_final, aim, miss, length = np.asarray(s_new), target_new, aim2, miss2, length2
     if progress is not None:
         progress(min(flights, rounds), rounds)

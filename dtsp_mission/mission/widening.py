@@ -3,7 +3,6 @@ or of a tour planned with a wider radius when that holds more targets or flies s
 
 from __future__ import annotations
 
-from dataclasses import replace
 from typing import Callable
 
 from ..errors import DtspError
@@ -25,11 +24,13 @@ def targets_beyond(mission: Mission, limit_m: float | None = None) -> int:
 def with_turn_margin(mission: Mission, replan: Callable[[float], Tour], targets: GeoTargets,
                      settings: MissionSettings,
                      progress: Callable[[int], Callable[[int, int], None]] | None = None) -> Mission:
-    """``mission`` if it is no guidance design or holds every target, else the best of it and the
-    missions of tours planned with wider turn radii (``replan(rho)``,
-    ``settings.tuning.guidance_margins``, tried in turn until one holds every target): the fewest targets
-    beyond the design limit, then the shortest predicted flight -- flight time is what the
-    operator pays for; how closely a flight follows its plan is only reported.
+    """``mission`` if it is no guidance design, else the best of it and the missions of tours
+    planned with wider turn radii (``replan(rho)``, ``settings.tuning.guidance_margins`` in
+    turn): the fewest targets beyond the design limit, then the shortest predicted flight --
+    flight time is what the operator pays for; how closely a flight follows its plan is only
+    reported.  A wider tour is planned only while the best design leaves targets beyond (or,
+    with ``tuning.widen_after_revisits``, holds them only by passing some twice), and designed
+    only if it is shorter than the best predicted flight of those holding every target.
     ``progress(k)`` gives the progress callback of the k-th design tried (``mission``'s was the
     0th)."""
     def key(candidate: Mission) -> tuple[int, float]:
@@ -38,23 +39,17 @@ def with_turn_margin(mission: Mission, replan: Callable[[float], Tour], targets:
         return mission
     best = mission
     for index, factor in enumerate(settings.tuning.guidance_margins):
-        if key(best)[0] == 0:
-            break
+        if key(best)[0] == 0 and (best.guidance.revisit_waypoints == 0
+                                  or not settings.tuning.widen_after_revisits):
+            break               # every target held
         try:
-            candidate = build_mission(replan(mission.rho_m * factor), mission.frame, targets,
-                                      settings, None if progress is None else progress(index + 1))
+            tour = replan(mission.rho_m * factor)
+            if key(best)[0] == 0 and tour.length_m >= best.guidance.predicted_flight_m:
+                break           # wider still is longer still
+            candidate = build_mission(tour, mission.frame, targets, settings,
+                                      None if progress is None else progress(index + 1))
         except DtspError:
             continue
-        if key(candidate) < key(best):
-            best = candidate
-    if key(best)[0] > 0 and settings.tuning.revisit_last and not settings.tuning.revisits:
-        # Still targets beyond: the best design again, those targets passed a second time.
-        again = replace(settings, tuning=replace(settings.tuning, revisits=True))
-        try:
-            candidate = build_mission(best.tour, best.frame, targets, again, None if progress is
-                                      None else progress(len(settings.tuning.guidance_margins) + 1))
-        except DtspError:
-            candidate = best
         if key(candidate) < key(best):
             best = candidate
     return best

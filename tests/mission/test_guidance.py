@@ -129,7 +129,7 @@ def test_loops_of_the_exact_path_get_waypoints_and_are_flown_round():
     loop: as first designed (one predicted flight, before any repair), fewer targets beyond
     the limit, a smaller worst miss, a predicted flight closer to the planned one."""
     tour, frame, targets = _fence(104.0)
-    first_flight = DesignTuning(rounds=1, refine_passes=0)
+    first_flight = DesignTuning(rounds=1, refine_passes=0, revisits=False)
     settings = MissionSettings(design="guidance", airspeed_m_s=22.0, altitude_m=120.0,
                                tuning=first_flight)
     looped = build_mission(tour, frame, targets, settings)
@@ -158,7 +158,7 @@ def test_the_repair_keeps_only_what_the_model_flew_better():
         return float(np.maximum(miss - limit, 0.0).sum()), int((miss > limit).sum())
     repaired = build_mission(tour, frame, targets, settings)
     first = build_mission(tour, frame, targets, replace(
-        settings, tuning=DesignTuning(rounds=1, refine_passes=0)))
+        settings, tuning=DesignTuning(rounds=1, refine_passes=0, revisits=False)))
     assert excess(repaired)[0] < excess(first)[0] and excess(repaired)[1] < excess(first)[1]
     assert 2 < repaired.summary["design_rounds"]
     # one predicted flight, the verifying one, then the design flown in each design wind
@@ -204,7 +204,7 @@ def test_the_local_repair_holds_more_and_reports_what_the_mission_flies():
                                tuning=eight)
     repaired = build_mission(tour, frame, targets, settings)
     unrepaired = build_mission(tour, frame, targets, replace(
-        settings, tuning=replace(eight, refine_passes=0)))
+        settings, tuning=replace(eight, refine_passes=0, revisits=False)))
     limit = settings.design_limit_m
     held = np.array(repaired.summary["predicted_miss_m"])          # in the forecast (calm) air
     before = np.array(unrepaired.summary["judged_miss_m"])
@@ -238,7 +238,8 @@ def test_the_turn_margin_keeps_a_design_that_holds_and_otherwise_ranks_by_the_fl
     mission = build_mission(tour, frame, targets, loose)
     assert targets_beyond(mission) == 0
     assert with_turn_margin(mission, replan, targets, loose) is mission and planned == []
-    strict = MissionSettings(altitude_m=120.0, airspeed_m_s=22.0, design="guidance")
+    strict = MissionSettings(altitude_m=120.0, airspeed_m_s=22.0, design="guidance",
+                             tuning=DesignTuning(revisits=False))
     mission = build_mission(tour, frame, targets, strict)
     assert targets_beyond(mission) > 0
     chosen = with_turn_margin(mission, replan, targets, strict)
@@ -257,10 +258,10 @@ def test_the_local_repair_s_other_starts_hold_what_small_steps_cannot():
     from dtsp_mission.mission.widening import targets_beyond as beyond
     tour, frame, targets = _fence(80.0)
     settings = MissionSettings(design="guidance", airspeed_m_s=22.0, altitude_m=120.0,
-                               wind_spread_m_s=0.0, tuning=DesignTuning(rounds=4))
+                               wind_spread_m_s=0.0, tuning=DesignTuning(rounds=4, revisits=False))
     alone = build_mission(tour, frame, targets, settings)
     assert beyond(alone) > 0
-    settings = replace(settings, tuning=DesignTuning(rounds=4, local_starts=100))
+    settings = replace(settings, tuning=DesignTuning(rounds=4, local_starts=100, revisits=False))
     started = build_mission(tour, frame, targets, settings)
     assert build_mission(tour, frame, targets, settings).items == started.items
     assert beyond(started) == 0
@@ -280,14 +281,15 @@ def _clustered(count: int, seed: int):
 @pytest.fixture(scope="module")
 def clustered_stuck():
     """A clustered site (80 targets, seed 2, rho 80 m; forecast wind only), its settings, and
-    its design without the local repair's second search (which leaves a target beyond)."""
+    its design without the local repair's second search and without second passes (which
+    leaves a target beyond)."""
     from dtsp_mission.api import plan_tour
     targets = _clustered(80, 2)
     tour, frame = plan_tour(targets, 80.0)
     settings = MissionSettings(design="guidance", airspeed_m_s=22.0, altitude_m=120.0,
                                home_deg=CENTRE, wind_spread_m_s=0.0)
     stuck = build_mission(tour, frame, targets, replace(
-        settings, tuning=DesignTuning(local_reset=False)))
+        settings, tuning=DesignTuning(local_reset=False, revisits=False)))
     return tour, frame, targets, settings, stuck
 
 
@@ -348,7 +350,7 @@ def test_a_target_left_beyond_is_passed_again_later_and_held(clustered_stuck):
     from dtsp_mission.sim.fly import planned_targets
     tour, frame, targets, settings, alone = clustered_stuck
     again = build_mission(tour, frame, targets, replace(
-        settings, tuning=DesignTuning(local_reset=False, revisits=True)))
+        settings, tuning=DesignTuning(local_reset=False, detour_rounds=0)))
     assert beyond(alone) > 0 and beyond(again) <= beyond(alone)
     limit = settings.checked(80.0).design_limit_m
     excess = [np.maximum(m.guidance.judged_miss_m - limit, 0.0).sum() for m in (alone, again)]
@@ -366,3 +368,36 @@ def test_a_target_left_beyond_is_passed_again_later_and_held(clustered_stuck):
                               flown.frame.to_local(passed.latitudes_deg, passed.longitudes_deg))
     order = [item.target for item in again.items if item.role == "target"]
     assert np.abs(miss - again.guidance.predicted_miss_m[order]).max() < 0.3
+
+
+@pytest.mark.heavy(seconds=40)
+def test_a_target_the_revisits_leave_beyond_gets_a_detour_with_a_straight_lead_in(clustered_stuck):
+    """A detour passes a stuck target again from a lead-in waypoint about two L1 distances
+    before it (a straight the guidance settles on) and rejoins the leg it left before that
+    leg's next waypoint; the design keeps it only where the robust cost falls, and the written
+    mission flown from the start passes the targets as the design reports."""
+    from dtsp_mission.mission.widening import targets_beyond as beyond
+    from dtsp_mission.sim.fly import planned_targets
+    tour, frame, targets, settings, alone = clustered_stuck
+    detoured = build_mission(tour, frame, targets, replace(
+        settings, tuning=DesignTuning(local_reset=False, revisit_rounds=0)))
+    limit = settings.checked(80.0).design_limit_m
+    excess = [np.maximum(m.guidance.judged_miss_m - limit, 0.0).sum() for m in (alone, detoured)]
+    assert excess[1] < excess[0] and beyond(detoured) <= beyond(alone)
+    items = detoured.items
+    passes = [k for k, item in enumerate(items) if item.role == "revisit"]
+    assert passes
+    airframe = Airframe.from_parameters(airspeed_m_s=22.0)
+    l1_m = airframe.l1_distance_m(22.0)
+    local = frame.to_local(np.array([i.latitude_deg for i in items]),
+                           np.array([i.longitude_deg for i in items]))
+    for k in passes:
+        assert items[k - 1].role == "shaping" and items[k + 1].role == "shaping"
+        lead_in = float(np.hypot(*(local[k - 1] - local[k])))
+        assert 1.5 * l1_m < lead_in < 2.5 * l1_m, (lead_in, l1_m)
+    flown = predict_flight(detoured.for_vehicle(), airframe)
+    passed = planned_targets(detoured)
+    miss = closest_approach_m(flown.track[:, 1:3],
+                              flown.frame.to_local(passed.latitudes_deg, passed.longitudes_deg))
+    order = [item.target for item in items if item.role == "target"]
+    assert np.abs(miss - detoured.guidance.predicted_miss_m[order]).max() < 0.3
