@@ -188,6 +188,11 @@ def build_mission(tour: Tour, frame: LocalFrame, targets: GeoTargets,
             tuple((w.speed_m_s, w.from_deg) for w in settings.design_winds()),
             sum(i.role == "revisit" for i in items))
         summary.update(guidance.as_summary())
+        # The flight as the model flies it from the take-off to the last target (the second
+        # passes, the turns the guidance swings wide), the exact path before and after it.
+        summary["flight_length_m"] += design.predicted_length_m - design.planned_length_m
+        if settings.airspeed_m_s is not None:
+            summary["flight_time_s"] = summary["flight_length_m"] / settings.airspeed_m_s
     autopilot = AUTOPILOTS[settings.autopilot]
     mission = Mission(tuple(items), Home(home_lat, home_lon, settings.home_altitude_amsl_m),
                       autopilot, settings.airspeed_m_s, tour.rho_m, tolerance, frame, tour, path,
@@ -200,7 +205,9 @@ def build_mission(tour: Tour, frame: LocalFrame, targets: GeoTargets,
 
 def _summary(tour: Tour, path: FlightPath, items: list[MissionItem],
              settings: MissionSettings, home_m: np.ndarray) -> dict:
-    """Lengths and times a user wants before flying (distances in metres, times in seconds)."""
+    """Lengths and times a user wants before flying (distances in metres, times in seconds),
+    along the exact path (:func:`build_mission` puts the predicted flight in for a guidance
+    design)."""
     climb = climb_distance_m(settings.altitude_m)
     flown = climb + path.chain.length_m
     if settings.return_mode != "none":    # straight home (RTL) or down the approach (land)

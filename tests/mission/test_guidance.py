@@ -52,6 +52,19 @@ def test_one_waypoint_per_target_and_every_target_predicted_within_the_limit(des
     assert mission.summary["predicted_flight_m"] == pytest.approx(mission.summary["planned_flight_m"], rel=0.08)
 
 
+def test_the_reported_flight_is_the_predicted_one_where_the_model_flew_it(designed):
+    """The flight length and time plan reports (and sorties and --endurance use) are the
+    model's flight from the take-off to the last target, the exact path before and after it:
+    not the exact path alone, which the autopilot does not fly."""
+    mission, _ = designed
+    summary = mission.summary
+    exact = build_mission(mission.tour, mission.frame, designed[1], MissionSettings(
+        altitude_m=120.0, airspeed_m_s=22.0, design="geometry")).summary["flight_length_m"]
+    assert summary["flight_length_m"] == pytest.approx(
+        exact + summary["predicted_flight_m"] - summary["planned_flight_m"], abs=1e-6)
+    assert summary["flight_time_s"] == pytest.approx(summary["flight_length_m"] / 22.0)
+
+
 def test_the_written_mission_flown_again_passes_every_target(designed):
     mission, targets = designed
     flight = predict_flight(mission.for_vehicle(), Airframe.from_parameters(airspeed_m_s=22.0))
