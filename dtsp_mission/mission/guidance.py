@@ -153,12 +153,17 @@ class DesignTuning:
     #: in turn, when the design at the radius asked for does not hold every target.
     guidance_margins: tuple[float, ...] = (1.3, 1.6)
     #: ... also when the design holds every target but only by passing some twice (revisits,
-    #: detours), if the wider tour is shorter than that design's predicted flight.  Measured
-    #: (docs/design-time.md, one core) on the bundled site and the uniform 100-400, clustered
-    #: 100/400 and dense 100/200 sites: shorter flights on two of eight (dense 100: 19.49 ->
-    #: 18.81 km, clustered 400: 95.54 -> 92.48 km) for 1.1-2.1 times the design time elsewhere
-    #: (bundled 43 -> 67 s, same flight).  Off by default: hold targets locally first.
+    #: detours), if the wider tour is shorter than ``widen_below`` of that design's predicted
+    #: flight: the second passes can cost more flight than wider turns.  Measured
+    #: (docs/design-time.md, one core): in calm air, designing the wider tour whenever it is
+    #: shorter than the flight shortened two of eight benchmark sites' flights by 3-4 % (dense
+    #: 100: 19.49 -> 18.81 km, clustered 400: 95.54 -> 92.48 km) and took 1.1-2.4 times the
+    #: design time elsewhere (bundled 20.6 -> 60.9 s, the same flight); in 5 m/s from 180 deg
+    #: on the bundled site it cut the flight from 2,011 to 1,472 s (docs/wind-design.md).  The
+    #: gate 0.8 keeps that gain; still off: in calm air it plans a wider tour it then skips
+    #: (bundled 28.7 -> 36.2 s, no site's flight shorter).
     widen_after_revisits: bool = False
+    widen_below: float = 0.8
     #: Targets the local repair leaves beyond are passed again later in the mission, before
     #: any wider tour is tried: one waypoint over each (its own acceptance radius), inserted
     #: where it lengthens the flight least (the straight-line detour, plus ``revisit_turn_m``

@@ -29,8 +29,9 @@ def with_turn_margin(mission: Mission, replan: Callable[[float], Tour], targets:
     turn): the fewest targets beyond the design limit, then the shortest predicted flight --
     flight time is what the operator pays for; how closely a flight follows its plan is only
     reported.  A wider tour is planned only while the best design leaves targets beyond (or,
-    with ``tuning.widen_after_revisits``, holds them only by passing some twice), and designed
-    only if it is shorter than the best predicted flight of those holding every target.
+    with ``tuning.widen_after_revisits``, holds them only by passing some twice), and, once a
+    design holds every target, designed only if it is shorter than ``tuning.widen_below`` of
+    that design's predicted flight.
     ``progress(k)`` gives the progress callback of the k-th design tried (``mission``'s was the
     0th)."""
     def key(candidate: Mission) -> tuple[int, float]:
@@ -44,8 +45,9 @@ def with_turn_margin(mission: Mission, replan: Callable[[float], Tour], targets:
             break               # every target held
         try:
             tour = replan(mission.rho_m * factor)
-            if key(best)[0] == 0 and tour.length_m >= best.guidance.predicted_flight_m:
-                break           # wider still is longer still
+            if key(best)[0] == 0 and (tour.length_m >= settings.tuning.widen_below
+                                      * best.guidance.predicted_flight_m):
+                break           # too little to gain, and wider still is longer still
             candidate = build_mission(tour, mission.frame, targets, settings,
                                       None if progress is None else progress(index + 1))
         except DtspError:
