@@ -29,6 +29,7 @@ from ..autopilot.commands import AUTOPILOTS, Command
 from ..autopilot.parameters import parameters_of
 from . import actions as action_items
 from .flight_path import climb_distance_m, plan_flight_path
+from .guidance import GuidanceDesign
 from .items import mission_items
 from .model import FlightPath, GuidancePrediction, Home, Mission, MissionItem
 from .placement import AtTargets, action_items_of, target_actions
@@ -173,7 +174,7 @@ def build_mission(tour: Tour, frame: LocalFrame, targets: GeoTargets,
                          f"{settings.max_items} mission slots")
     items = at_targets.inserted(mission_items(path, chosen, frame, targets, settings, home_lat, home_lon,
                                        design))
-    summary = _summary(tour, path, items, settings, home_m)
+    summary = _summary(tour, path, items, settings, home_m, design)
     if at_targets.count:
         counts = Counter(item.role for item in items)
         summary["actions"] = {role: counts[role] for role in ("photo", "roi", "gimbal", "loiter")
@@ -188,11 +189,6 @@ def build_mission(tour: Tour, frame: LocalFrame, targets: GeoTargets,
             tuple((w.speed_m_s, w.from_deg) for w in settings.design_winds()),
             sum(i.role == "revisit" for i in items))
         summary.update(guidance.as_summary())
-        # The flight as the model flies it from the take-off to the last target (the second
-        # passes, the turns the guidance swings wide), the exact path before and after it.
-        summary["flight_length_m"] += design.predicted_length_m - design.planned_length_m
-        if settings.airspeed_m_s is not None:
-            summary["flight_time_s"] = summary["flight_length_m"] / settings.airspeed_m_s
     autopilot = AUTOPILOTS[settings.autopilot]
     mission = Mission(tuple(items), Home(home_lat, home_lon, settings.home_altitude_amsl_m),
                       autopilot, settings.airspeed_m_s, tour.rho_m, tolerance, frame, tour, path,
@@ -204,14 +200,18 @@ def build_mission(tour: Tour, frame: LocalFrame, targets: GeoTargets,
 
 
 def _summary(tour: Tour, path: FlightPath, items: list[MissionItem],
-             settings: MissionSettings, home_m: np.ndarray) -> dict:
-    """Lengths and times a user wants before flying (distances in metres, times in seconds),
-    along the exact path (:func:`build_mission` puts the predicted flight in for a guidance
-    design)."""
+             settings: MissionSettings, home_m: np.ndarray,
+             design: GuidanceDesign | None = None) -> dict:
+    """Lengths and times a user wants before flying (distances in metres, times in seconds):
+    along the exact path, and for a guidance ``design`` the model's flight from the take-off to
+    the last target instead of that part of it (the second passes, the turns the guidance swings
+    wide)."""
     climb = climb_distance_m(settings.altitude_m)
     flown = climb + path.chain.length_m
     if settings.return_mode != "none":    # straight home (RTL) or down the approach (land)
         flown += float(np.hypot(*(path.chain.ends()[-1, :2] - home_m)))
+    if design is not None:
+        flown += design.predicted_length_m - design.planned_length_m
     summary = {"targets": len(tour.targets_m), "tour_length_m": tour.length_m,
                "path_length_m": path.chain.length_m, "flight_length_m": flown,
                "items": len(items), "waypoints": sum(i.command == Command.NAV_WAYPOINT for i in items)}

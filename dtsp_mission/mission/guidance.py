@@ -662,7 +662,8 @@ def design_waypoints(path: FlightPath, targets_m: np.ndarray, altitudes_m: np.nd
         target_of.insert(k, -1)
     takeoff = path.chain.pose_at(np.array([0.0]))[0, :2] - home
     heading = math.atan2(takeoff[1], takeoff[0])
-    lookback_m = tuning.lookback_l1 * airframe.l1_distance_m(airframe.airspeed_m_s)
+    l1_m = airframe.l1_distance_m(airframe.airspeed_m_s)
+    lookback_m = tuning.lookback_l1 * l1_m
     # The design flies each loiter's first design_loiter_turns turns: later turns repeat the
     # last one (same circle, same exit), so they add their length and change no miss.
     loiters = {span.target: (float(span.centre_m[0] - home[0]), float(span.centre_m[1] - home[1]),
@@ -760,7 +761,7 @@ def design_waypoints(path: FlightPath, targets_m: np.ndarray, altitudes_m: np.nd
     flights += flown
     s_final, target_final = design.s_m, list(best.target_of)
     # Targets still beyond: passed again (plain revisits while they help), then by detours.
-    lead_m = tuning.revisit_lead_l1 * airframe.l1_distance_m(airframe.airspeed_m_s)
+    lead_m = tuning.revisit_lead_l1 * l1_m
     kinds = ([0.0] * tuning.revisit_rounds + [lead_m] * tuning.detour_rounds
              if tuning.revisits else [])
     failed = None
