@@ -28,6 +28,7 @@ from .mission.settings import check_altitude_floor
 from .mission.sorties import Sortie, split_into_sorties
 from .planning import TilingUnavailable, get_planner
 from .planning.lower_bounds import LowerBound, lower_bound
+from .planning.wind_tour import WindTour, plan_wind_tour
 from .targets import GeoTargets, Targets
 from .tour import Tour
 
@@ -78,6 +79,9 @@ class PlanResult:
     ``sorties``, when not empty, are to be flown instead (``split_reason`` says why).  ``notes`` are the decisions a user should know about, in
     the order they were taken.  ``tour`` is the tour at the radius asked for; the guidance
     design may have planned the mission with a wider one (``mission.tour``, ``mission.rho_m``).
+    ``wind_tour`` is, for a mission in a forecast wind at a given airspeed, the tour's order
+    flown in that wind with the air headings chosen for time (checked), the measure of what the
+    flight costs in that wind.
     """
 
     local: Targets
@@ -90,6 +94,7 @@ class PlanResult:
     sorties: list[Sortie] = field(default_factory=list)
     split_reason: str | None = None
     notes: list[str] = field(default_factory=list)
+    wind_tour: WindTour | None = None
 
     @cached_property
     def bound(self) -> LowerBound:
@@ -215,6 +220,11 @@ def run_plan(request: PlanRequest,
                         request.fallback, progress, notes)
     result = PlanResult(local, geodetic, frame, tour, time.perf_counter() - started, area_m,
                         notes=notes)
+    settings = request.settings
+    if settings is not None and settings.wind.speed_m_s > 0 and settings.airspeed_m_s:
+        result.wind_tour = plan_wind_tour(tour.targets_m, tour.visit_order, tour.rho_m,
+                                          settings.airspeed_m_s, settings.wind.velocity_m_s)
+        result.wind_tour.check().raise_if_invalid()
     if request.settings is not None:
         _design_mission(request, result, design_progress)
     return result

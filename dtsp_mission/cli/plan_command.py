@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+import math
 import os
 from dataclasses import replace
 from pathlib import Path
@@ -310,12 +311,29 @@ def _report(result: PlanResult, settings: MissionSettings | None,
         note(text)
     if result.mission is not None:
         _report_mission(result.mission)
+        _report_wind_tour(result)
         _warn_far_home(result.mission, result.local.positions_m, result.frame)
     elif settings is None and airspeed_m_s:
         say(f"flight time of the tour at {airspeed_m_s:g} m/s: "
             f"{_duration(result.tour.length_m / airspeed_m_s)}")
     if result.sorties:
         _report_sorties(result, settings.max_miss_m)
+
+
+def _report_wind_tour(result: PlanResult) -> None:
+    """The tour flown in the forecast wind, against the calm tour and the designed flight."""
+    windy, mission = result.wind_tour, result.mission
+    if windy is None:
+        return
+    calm_s = result.tour.length_m / windy.airspeed_m_s
+    line = (f"tour in the forecast wind: {_duration(windy.time_s)} at {windy.airspeed_m_s:g} m/s "
+            f"(calm air: {_duration(calm_s)}; the planner's order, air headings for the wind)")
+    flight_s = mission.guidance.predicted_flight_s if mission.guidance is not None else math.nan
+    if math.isfinite(flight_s):
+        line += (f"; the mission's predicted flight (take-off to the last target) "
+                 f"{_duration(flight_s)}, {flight_s / windy.time_s:.2f} x the tour")
+    say(line)
+    record(wind_tour_time_s=windy.time_s, wind_tour_air_length_m=windy.air_length_m)
 
 
 def _report_sorties(result: PlanResult, max_miss_m: float) -> None:
@@ -423,6 +441,8 @@ def _report_mission(mission) -> None:
     line = f"flight: {summary['flight_length_m'] / 1e3:,.2f} km from take-off to the return"
     if "flight_time_s" in summary:
         line += f", {_duration(summary['flight_time_s'])} at {mission.cruise_speed_m_s:g} m/s"
+        if guidance is not None and guidance.design_wind[0] > 0:
+            line += f" {_wind_text(guidance.design_wind)} (the model's time; the climb-out and return timed against the wind)"
     say(line)
     for text in mission.notes:
         note(text)

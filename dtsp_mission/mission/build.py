@@ -13,6 +13,7 @@ the approach waypoint and NAV_LAND at home, or nothing.
 
 from __future__ import annotations
 
+import math
 from collections import Counter
 from dataclasses import dataclass
 from typing import Callable
@@ -187,7 +188,7 @@ def build_mission(tour: Tour, frame: LocalFrame, targets: GeoTargets,
             sum(i.role == "shaping" for i in items), design.rounds,
             (settings.wind.speed_m_s, settings.wind.from_deg), settings.wind_spread_m_s,
             tuple((w.speed_m_s, w.from_deg) for w in settings.design_winds()),
-            sum(i.role == "revisit" for i in items))
+            sum(i.role == "revisit" for i in items), design.predicted_time_s)
         summary.update(guidance.as_summary())
     autopilot = AUTOPILOTS[settings.autopilot]
     mission = Mission(tuple(items), Home(home_lat, home_lon, settings.home_altitude_amsl_m),
@@ -205,7 +206,8 @@ def _summary(tour: Tour, path: FlightPath, items: list[MissionItem],
     """Lengths and times a user wants before flying (distances in metres, times in seconds):
     along the exact path, and for a guidance ``design`` the model's flight from the take-off to
     the last target instead of that part of it (the second passes, the turns the guidance swings
-    wide)."""
+    wide) and its time in the forecast wind, the rest of the flight timed as if all against the
+    wind (``flight_time_s``; without a design: the length at the airspeed)."""
     climb = climb_distance_m(settings.altitude_m)
     flown = climb + path.chain.length_m
     if settings.return_mode != "none":    # straight home (RTL) or down the approach (land)
@@ -217,4 +219,9 @@ def _summary(tour: Tour, path: FlightPath, items: list[MissionItem],
                "items": len(items), "waypoints": sum(i.command == Command.NAV_WAYPOINT for i in items)}
     if settings.airspeed_m_s is not None:
         summary["flight_time_s"] = flown / settings.airspeed_m_s
+        if design is not None and math.isfinite(design.predicted_time_s):
+            # The model's time where it flew; the rest (climb-out, return) against the wind.
+            rest_m = flown - design.predicted_length_m
+            summary["flight_time_s"] = design.predicted_time_s + rest_m / max(
+                settings.airspeed_m_s - settings.wind.speed_m_s, 0.3 * settings.airspeed_m_s)
     return summary

@@ -221,6 +221,9 @@ class GuidanceDesign:
     judged_miss_m: np.ndarray | None = None
     #: per target, the worst miss over the design winds; None: the forecast's miss
     worst_miss_m: np.ndarray | None = None
+    #: predicted time (s) over the span of ``predicted_length_m`` in the forecast wind (loiter
+    #: turns the design does not fly counted at the airspeed); NaN: not predicted
+    predicted_time_s: float = math.nan
 
     @property
     def shaping(self) -> int:
@@ -791,10 +794,17 @@ def design_waypoints(path: FlightPath, targets_m: np.ndarray, altitudes_m: np.nd
     final, _ = _local_items(takeoff, takeoff_alt, head_items, aim - home,
                             waypoint_altitudes_m(path, s_final, target_final), target_final,
                             target_acceptance_m, loiters)
-    misses = [run.closest_m for run in _each(
-        lambda wind: MissionFlight(final, airframe, heading, 1, wind).run(
-            tuning.verify_step_s, len(final) - 2, points_m=targets_m - home, track=False,
-            measure_from_seq=_AFTER_TAKEOFF, until_s=FLIGHT_LIMIT_S), winds)]
+
+    def verified(wind: Wind) -> tuple[np.ndarray, float]:
+        """Misses of the final design in ``wind``, and its time from the take-off's end."""
+        flight = MissionFlight(final, airframe, heading, 1, wind)
+        run = flight.run(tuning.verify_step_s, len(final) - 2, points_m=targets_m - home,
+                         track=False, measure_from_seq=_AFTER_TAKEOFF, until_s=FLIGHT_LIMIT_S)
+        start = dict(flight.reached).get(_AFTER_TAKEOFF - 1, 0.0)
+        return run.closest_m, flight.time_s - start
+    flown = _each(verified, winds)
+    misses = [miss for miss, _ in flown]
     return GuidanceDesign(np.asarray(s_final), aim, np.asarray(target_final), misses[0], length + skipped_m,
                           design.planned_length_m, flights + len(winds),
-                          _judged(misses, spread_margin_m), np.max(misses, axis=0))
+                          _judged(misses, spread_margin_m), np.max(misses, axis=0),
+                          flown[0][1] + skipped_m / airframe.airspeed_m_s)

@@ -7,6 +7,7 @@ so that uploaders and the simulated vehicle need nothing of the designer.
 
 from __future__ import annotations
 
+import math
 from dataclasses import dataclass, field
 from typing import Any
 
@@ -72,7 +73,8 @@ class GuidancePrediction:
     design is judged by (the forecast's, or the worst of the others less the model's margin,
     whichever is further beyond its limit: held when at most ``design_limit_m``).  The
     predicted flight and the planned one over the same span, the shaping waypoints added, the
-    predicted flights made, the waypoints passing a target a second time, the forecast wind (speed m/s, from deg) with its spread (m/s) and
+    predicted flights made, the waypoints passing a target a second time, the predicted
+    flight's time (s, NaN if not predicted), the forecast wind (speed m/s, from deg) with its spread (m/s) and
     the winds flown.
     """
 
@@ -88,6 +90,7 @@ class GuidancePrediction:
     wind_spread_m_s: float
     design_winds: tuple[tuple[float, float], ...]
     revisit_waypoints: int = 0
+    predicted_flight_s: float = math.nan    # the predicted flight's time in the forecast wind
 
     def targets_beyond(self, limit_m: float | None = None) -> int:
         """Targets not held: judged beyond the design limit; with ``limit_m``, predicted
@@ -104,6 +107,7 @@ class GuidancePrediction:
                 "worst_wind_miss_m": self.worst_wind_miss_m.tolist(),
                 "predicted_flight_m": self.predicted_flight_m,
                 "planned_flight_m": self.planned_flight_m,
+                "predicted_flight_s": self.predicted_flight_s,
                 "shaping_waypoints": self.shaping_waypoints, "design_rounds": self.design_rounds,
                 "revisit_waypoints": self.revisit_waypoints,
                 "design_wind": {"speed_m_s": speed, "from_deg": from_deg,

@@ -107,7 +107,8 @@ def check_path(chain: SegmentChain, rho_m: float, targets_m: np.ndarray, visit_s
         following = np.roll(chain.starts, -1, axis=0)
         gaps = np.hypot(*(ends[:, :2] - following[:, :2]).T)
         heading_errors = np.abs(wrap_angle(ends[:, 2] - following[:, 2]))
-        max_gap, max_heading = _finite_max(gaps), _finite_max(heading_errors)
+        joints = slice(None) if closed else slice(None, -1)      # an open path's end is free
+        max_gap, max_heading = _finite_max(gaps[joints]), _finite_max(heading_errors[joints])
         broken = (gaps > tolerance_m) | (heading_errors > tolerance_rho)
         if broken[:-1].any():
             first = int(np.argmax(broken[:-1]))

@@ -240,3 +240,23 @@ def test_the_plot_shows_direction_visits_take_off_return_and_scale(tmp_path):
         assert label in text, label
     assert re.search(r">\d+ (m|km)<", text)                       # the scale bar
     assert pdf.read_bytes()[:4] == b"%PDF"
+
+
+def test_plan_in_a_forecast_wind_reports_the_tour_for_that_wind_and_the_models_flight_time(tmp_path):
+    """--wind: the report names the tour flown in that wind and the flight against it; the
+    JSON summary has both times, the flight's the model's in that wind."""
+    rng = np.random.default_rng(11)
+    site = tmp_path / "site.csv"
+    site.write_text("name,lat,lon\n" + "".join(
+        f"t{k},{47.40 + 0.01 * rng.random():.7f},{8.50 + 0.015 * rng.random():.7f}\n"
+        for k in range(15)))
+    result = run(site, "--radius", "80", "--alt", "120", "--airspeed", "22", "--wind", "6@270",
+                 "-o", tmp_path / "m.plan", "--json")
+    assert result.returncode == 0, result.stderr
+    assert "tour in the forecast wind:" in result.stderr
+    assert "in a wind of 6 m/s from 270 deg (the model's time" in result.stderr
+    summary = json.loads(result.stdout)
+    assert summary["wind_tour_time_s"] > 0
+    assert summary["wind_tour_air_length_m"] == pytest.approx(22 * summary["wind_tour_time_s"])
+    assert (summary["flight_length_m"] / 28 < summary["flight_time_s"]
+            < summary["flight_length_m"] / 16)
