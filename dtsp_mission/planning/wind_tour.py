@@ -10,11 +10,13 @@ displacement ``q - p`` and the two headings -- not on when the leg starts -- so 
 is a tour over a time cost, asymmetric (upwind is slower than downwind), on the same targets
 and orders as in calm air (McGee and Hedrick's virtual target, Techy and Woolsey's trochoids).
 
-A leg's time is the *earliest* ``T`` with ``L(T) <= V T`` (bisection from ``T = L(0)/V``).
-Where the Dubins length jumps there (the goal crossing into or out of a word's domain), the
-shortest path would arrive early; such a pair of headings is not used (its cost is infinite),
-so every leg kept arrives over its target to within a micrometre-scale tolerance, which
-:meth:`WindTour.check` verifies with the tours' own checker on the chain in the air mass.
+A leg's time is the *earliest* ``T`` with ``L(T) = V T``, but for arrivals possible only within
+a window shorter than ``_MAX_STEP_RHO * rho / V`` behind a downward jump of the Dubins length
+(the wind carrying the target across the heading line, say); see ``_leg_time``.  Where the
+length jumps at the time found, the shortest path would arrive early; such a pair of headings is
+not used (its cost is infinite), so every leg kept arrives over its target to within a
+micrometre-scale tolerance, which :meth:`WindTour.check` verifies with the tours' own checker on
+the chain in the air mass.
 
 :func:`plan_wind_tour` keeps a given order (the calm planner's, or its reverse when that is
 faster) and chooses the air headings at the targets for the least flight time: exact dynamic
@@ -40,6 +42,9 @@ from .headings import _best_cycle, edge_directions, straight_through_headings
 
 #: A leg whose shortest path would pass its target more than this (times rho) off is not used.
 _LEG_TOLERANCE_RHO = 1e-9
+#: The search for a leg's time steps at most this many rho of flight: an arrival possible only
+#: for a shorter time (behind a jump of the Dubins length) may be passed over.
+_MAX_STEP_RHO = 0.25
 
 
 @numba.njit(cache=True)
@@ -61,7 +66,8 @@ def _leg_time(x0: float, y0: float, th0: float, x1: float, y1: float, th1: float
     dx, dy = x1 - x0, y1 - y0
     # No arrival before the straight-line time (|d - w T| = v T), and the slack
     # g(T) = L(T) - v T falls at most at v + w where the length is continuous: steps of
-    # g / (v + w) from there pass no arrival but one behind a downward jump of the length.
+    # g / (v + w) from there pass no arrival but one behind a downward jump of the length, and
+    # steps of at most _MAX_STEP_RHO rho / v none of those that stays open that long.
     along, a = dx * wx + dy * wy, v * v - w * w
     t = (-along + math.sqrt(along * along + a * (dx * dx + dy * dy))) / a
     previous = t
@@ -73,7 +79,7 @@ def _leg_time(x0: float, y0: float, th0: float, x1: float, y1: float, th1: float
         if g < 0.0:
             break
         previous = t
-        t += g / (v + w)
+        t += min(g / (v + w), _MAX_STEP_RHO * rho / v)
     else:
         return np.inf
     # Behind a jump: the first time in (previous, t] the path is not late, if it is on time.

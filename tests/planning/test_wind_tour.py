@@ -9,8 +9,8 @@ from hypothesis import given, settings, strategies as st
 from dtsp_mission.dubins import shortest_length
 from dtsp_mission.errors import InputError
 from dtsp_mission.planning.euclidean_tour import euclidean_tour
-from dtsp_mission.planning.wind_tour import (_air_length, crab_headings, leg_times_s,
-                                             plan_wind_tour)
+from dtsp_mission.planning.wind_tour import (_MAX_STEP_RHO, _air_length, crab_headings,
+                                             leg_times_s, plan_wind_tour)
 
 V, RHO = 22.0, 80.0
 
@@ -61,16 +61,25 @@ def test_a_leg_flown_backwards_in_the_opposite_wind_takes_the_same_time(x, y, a,
        st.floats(-math.pi, math.pi), st.floats(0.5, 0.7 * V), st.floats(0, 2 * math.pi))
 def test_a_leg_arrives_on_time_and_no_earlier_time_would_do(x, y, a, b, speed, towards):
     """The shortest path in the air mass to where the target is after the leg's time takes that
-    time; at no earlier time (sampled) is it short enough.  A leg found no time is refused."""
+    time; at no earlier time (sampled) is it short enough, but within a window too short for the
+    search's step (the wind carrying the target across the heading line).  A leg found no time
+    is refused."""
     wind = np.array([speed * math.cos(towards), speed * math.sin(towards)])
     t = leg_times_s(np.array([[0.0, 0.0], [x, y]]), np.array([a, b]), RHO, V, tuple(wind))[0]
     if not math.isfinite(t):
         return
     assert _air_length(0.0, 0.0, a, x - wind[0] * t, y - wind[1] * t, b, RHO) == pytest.approx(
         V * t, abs=1e-6)
+
+    def arrives(s: float) -> bool:
+        return _air_length(0.0, 0.0, a, x - wind[0] * s, y - wind[1] * s, b, RHO) <= V * s - 1e-6
+
+    window = _MAX_STEP_RHO * RHO / V      # arrivals possible for less than this may be passed
     straight = np.hypot(x, y) / (V + speed)
-    for s in np.linspace(straight, t, 200, endpoint=False):
-        assert _air_length(0.0, 0.0, a, x - wind[0] * s, y - wind[1] * s, b, RHO) > V * s - 1e-6
+    for s in np.linspace(straight, t, 400, endpoint=False):
+        if arrives(s):
+            around = [u for u in s + np.linspace(-window, window, 81) if straight <= u < t]
+            assert not all(arrives(u) for u in around if abs(u - s) <= window / 2), (s, t)
 
 
 @settings(max_examples=25, deadline=None)
