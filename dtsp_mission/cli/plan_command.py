@@ -442,7 +442,8 @@ def _report_mission(mission) -> None:
     if "flight_time_s" in summary:
         line += f", {_duration(summary['flight_time_s'])} at {mission.cruise_speed_m_s:g} m/s"
         if guidance is not None and guidance.design_wind[0] > 0:
-            line += f" {_wind_text(guidance.design_wind)} (the model's time; the climb-out and return timed against the wind)"
+            line += (f" {_wind_text(guidance.design_wind)} (the model's time; the climb-out "
+                     "and return timed against the wind)")
     say(line)
     for text in mission.notes:
         note(text)
