@@ -2,7 +2,7 @@
 
 from .check import TOLERANCE_RHO, CheckReport, check_tour
 from .json_form import read_tour, tour_from_dict, tour_to_dict, write_tour
-from .model import Tour, reversed_tour, tour_through_poses
+from .model import Tour, tour_through_poses
 
-__all__ = ["TOLERANCE_RHO", "CheckReport", "Tour", "check_tour", "read_tour", "reversed_tour", "tour_from_dict",
+__all__ = ["TOLERANCE_RHO", "CheckReport", "Tour", "check_tour", "read_tour", "tour_from_dict",
            "tour_through_poses", "tour_to_dict", "write_tour"]

@@ -113,12 +113,3 @@ def tour_through_poses(targets_m: np.ndarray, order: np.ndarray, headings_rad: n
     visit_s = snap_visits(chain, targets_m, visit_s)
     return Tour(chain, float(rho_m), targets_m, visit_s, planner, dict(parameters or {}))
 
-
-def reversed_tour(tour: Tour) -> Tour:
-    """The same closed tour flown the other way round: the targets in the reverse order, each
-    passed heading the opposite way (the shortest Dubins path reversed is the shortest back, so
-    the length is the same)."""
-    order = tour.visit_order[::-1].copy()
-    headings = tour.visit_poses()[order, 2] + np.pi
-    return tour_through_poses(tour.targets_m, order, headings, tour.rho_m, tour.planner,
-                              tour.parameters)
