@@ -152,7 +152,7 @@ class WindTour:
         """Length of the path in the air mass (the airspeed times the time)."""
         return self.airspeed_m_s * self.time_s
 
-    def _air_legs(self) -> tuple[list[SegmentChain], np.ndarray]:
+    def _air_legs(self) -> list[SegmentChain]:
         points = self.targets_m[self.order]
         w = np.asarray(self.wind_m_s, dtype=float)
         starts = np.concatenate([[0.0], np.cumsum(self.leg_time_s)[:-1]])
@@ -164,12 +164,12 @@ class WindTour:
             legs.append(shortest_path(np.append(here, self.air_headings_rad[k]),
                                       np.append(there, self.air_headings_rad[j]),
                                       self.rho_m).chain())
-        return legs, starts
+        return legs
 
     def air_chain(self) -> SegmentChain:
         """The whole path in the air mass (lines and arcs of radius ``rho_m``), from the first
         target; the air mass is taken where it is at the first visit."""
-        return SegmentChain.concatenate(self._air_legs()[0])
+        return SegmentChain.concatenate(self._air_legs())
 
     def ground_xy_m(self, s_m: np.ndarray) -> np.ndarray:
         """Positions over the ground at air arc lengths ``s_m`` from the first target."""
@@ -182,7 +182,7 @@ class WindTour:
         each target where the air mass has carried it at its visit time, on the path within
         ``tolerance_rho * rho``), and the tour closed over the ground: back over the first
         target at its heading."""
-        legs, _ = self._air_legs()
+        legs = self._air_legs()
         chain = SegmentChain.concatenate(legs)
         points = self.targets_m[self.order]
         w = np.asarray(self.wind_m_s, dtype=float)
@@ -213,7 +213,7 @@ def crab_headings(ground_rad: np.ndarray, airspeed_m_s: float,
     (the wind slower than the airspeed)."""
     d = np.column_stack([np.cos(ground_rad), np.sin(ground_rad)])
     w = np.asarray(wind_m_s, dtype=float)
-    across = w - np.outer(d @ w, w.dtype.type(1.0)) * d
+    across = w - (d @ w)[:, None] * d
     along = np.sqrt(np.maximum(airspeed_m_s ** 2 - (across ** 2).sum(axis=1), 0.0))
     air = along[:, None] * d - across
     return np.arctan2(air[:, 1], air[:, 0])
@@ -241,8 +241,7 @@ def plan_wind_tour(targets_m: np.ndarray, order: np.ndarray, rho_m: float, airsp
     candidate air headings per target (those that track the edges in and out over the ground
     -- a straight leg between two targets needs both --, and ``grid`` evenly spaced from the one
     tracking the chord from the target before to the one after), chosen exactly by dynamic
-    programming.  The
-    tour passes :meth:`WindTour.check`; a target appears once in ``order``."""
+    programming.  The tour passes :meth:`WindTour.check`; a target appears once in ``order``."""
     targets = np.asarray(targets_m, dtype=float).reshape(-1, 2)
     order = np.asarray(order, dtype=np.int64)
     wind = (float(wind_m_s[0]), float(wind_m_s[1]))

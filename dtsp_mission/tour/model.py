@@ -112,4 +112,3 @@ def tour_through_poses(targets_m: np.ndarray, order: np.ndarray, headings_rad: n
     visit_s[order] = leg_start_s
     visit_s = snap_visits(chain, targets_m, visit_s)
     return Tour(chain, float(rho_m), targets_m, visit_s, planner, dict(parameters or {}))
-

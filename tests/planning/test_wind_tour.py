@@ -97,7 +97,7 @@ def test_every_wind_tour_passes_the_checker_and_overflies_every_target(n, seed, 
     # Independently of the checker: over the ground, the path is over each target when the
     # aircraft has flown the legs before it.
     chain = tour.air_chain()
-    lengths = np.array([leg.length_m for leg in tour._air_legs()[0]])
+    lengths = np.array([leg.length_m for leg in tour._air_legs()])
     offsets = np.concatenate([[0.0], np.cumsum(lengths)[:-1]])
     np.testing.assert_allclose(tour.ground_xy_m(offsets), targets[tour.order], atol=1e-6 * RHO)
     assert chain.length_m == pytest.approx(tour.air_length_m, rel=1e-9)
