@@ -66,7 +66,8 @@ def main() -> None:
             for _ in range(3):
                 started = time.perf_counter()
                 windy = plan_wind_tour(tour.targets_m, tour.visit_order, RHO_M, AIRSPEED_M_S,
-                                       wind.velocity_m_s)
+                                       wind.velocity_m_s,
+                                       ground_headings_rad=tour.visit_poses()[:, 2])
                 seconds.append(time.perf_counter() - started)
             report = windy.check()
             flight_s = float(row["flight_s"])

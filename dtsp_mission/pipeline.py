@@ -223,7 +223,8 @@ def run_plan(request: PlanRequest,
     settings = request.settings
     if settings is not None and settings.wind.speed_m_s > 0 and settings.airspeed_m_s:
         result.wind_tour = plan_wind_tour(tour.targets_m, tour.visit_order, tour.rho_m,
-                                          settings.airspeed_m_s, settings.wind.velocity_m_s)
+                                          settings.airspeed_m_s, settings.wind.velocity_m_s,
+                                          ground_headings_rad=tour.visit_poses()[:, 2])
         result.wind_tour.check().raise_if_invalid()
     if request.settings is not None:
         _design_mission(request, result, design_progress)

@@ -119,6 +119,35 @@ def test_a_tour_in_wind_is_slower_than_in_calm_air_and_the_same_in_calm_air():
     assert min(tour.time_s for tour in windy) > calm.time_s
 
 
+def test_in_calm_air_the_tour_is_never_slower_than_the_calm_tour_it_starts_from():
+    """With the calm tour's headings among the candidates, calm air gives back at most its
+    length at the airspeed (the order improved on time can only shorten it)."""
+    from dtsp_mission.pipeline import plan_tour_in
+    rng = np.random.default_rng(11)
+    targets = rng.uniform(0, 1200, (30, 2))
+    tour = plan_tour_in(targets, RHO, parameters={"time_limit_s": 0.5})
+    calm = plan_wind_tour(targets, tour.visit_order, RHO, V, (0.0, 0.0),
+                          ground_headings_rad=tour.visit_poses()[:, 2])
+    assert calm.check().ok
+    assert calm.time_s <= tour.length_m / V * (1 + 1e-12)
+
+
+def test_the_order_improved_for_the_wind_is_faster_and_never_slower():
+    """Or-opt on flight time: in a strong wind over dense targets it finds a faster order
+    (measured: 2-10 % on the benchmark sites in 5-8 m/s), and it never returns a slower one."""
+    rng = np.random.default_rng(4)
+    targets = rng.uniform(0, 1500, (40, 2))
+    order = euclidean_tour(targets)
+    for towards in np.linspace(0, 2 * math.pi, 4, endpoint=False):
+        wind = (8 * math.cos(towards), 8 * math.sin(towards))
+        kept = plan_wind_tour(targets, order, RHO, V, wind, improve=False)
+        improved = plan_wind_tour(targets, order, RHO, V, wind)
+        assert improved.check().ok
+        assert sorted(improved.order.tolist()) == list(range(len(targets)))
+        assert improved.time_s <= kept.time_s
+    assert improved.time_s < kept.time_s * 0.999, (improved.time_s, kept.time_s)
+
+
 @pytest.mark.parametrize("arguments, message", [
     (dict(wind_m_s=(22.0, 0.0)), "not slower than the airspeed"),
     (dict(wind_m_s=(math.nan, 0.0)), "not slower than the airspeed"),
