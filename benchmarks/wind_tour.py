@@ -4,9 +4,9 @@
 
 Per site and forecast wind of ``docs/wind-design.csv`` (the flights of
 ``benchmarks/wind_design.py``): the tour the planner finds at rho 80 m (as there), its time at
-22 m/s in calm air, and the time of the tour for that wind (``planning.wind_tour``: the same
-order or its reverse, the air headings chosen for the least flight time, Dubins paths in the air
-mass), each checked; against them, the flight time of the mission designed for that wind as the
+22 m/s in calm air, and the time of the tour for that wind (``planning.wind_tour``: from the
+same order or its reverse, the air headings chosen for the least flight time and refined, the
+order then improved on time, Dubins paths in the air mass), each checked; against them, the flight time of the mission designed for that wind as the
 design benchmark measured it in the forecast wind (take-off to the last target: it is not a
 closed tour, so the comparison flatters the flight by the last leg and takes the climb-out
 against it).  Median of 3 runs of the wind tour's planning (one core).

@@ -79,8 +79,8 @@ class PlanResult:
     ``sorties``, when not empty, are to be flown instead (``split_reason`` says why).  ``notes`` are the decisions a user should know about, in
     the order they were taken.  ``tour`` is the tour at the radius asked for; the guidance
     design may have planned the mission with a wider one (``mission.tour``, ``mission.rho_m``).
-    ``wind_tour`` is, for a mission in a forecast wind at a given airspeed, the tour's order
-    flown in that wind with the air headings chosen for time (checked), the measure of what the
+    ``wind_tour`` is, for a mission in a forecast wind at a given airspeed, the tour for that
+    wind (from the tour's order, headings and order improved for time; checked), the measure of what the
     flight costs in that wind.
     """
 

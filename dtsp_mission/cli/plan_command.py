@@ -327,7 +327,7 @@ def _report_wind_tour(result: PlanResult) -> None:
         return
     calm_s = result.tour.length_m / windy.airspeed_m_s
     line = (f"tour in the forecast wind: {_duration(windy.time_s)} at {windy.airspeed_m_s:g} m/s "
-            f"(calm air: {_duration(calm_s)}; the planner's order, air headings for the wind)")
+            f"(calm air: {_duration(calm_s)}; headings and order improved for the wind)")
     flight_s = mission.guidance.predicted_flight_s if mission.guidance is not None else math.nan
     if math.isfinite(flight_s):
         line += (f"; the mission's predicted flight (take-off to the last target) "
