@@ -80,8 +80,8 @@ class PlanResult:
     the order they were taken.  ``tour`` is the tour at the radius asked for; the guidance
     design may have planned the mission with a wider one (``mission.tour``, ``mission.rho_m``).
     ``wind_tour`` is, for a mission in a forecast wind at a given airspeed, the tour for that
-    wind (from the tour's order, headings and order improved for time; checked), the measure of what the
-    flight costs in that wind.
+    wind (from the tour's order, headings and order improved for time; checked), the measure
+    of what the flight costs in that wind.
     """
 
     local: Targets

@@ -18,10 +18,12 @@ not used (its cost is infinite), so every leg kept arrives over its target to wi
 micrometre-scale tolerance, which :meth:`WindTour.check` verifies with the tours' own checker on
 the chain in the air mass.
 
-:func:`plan_wind_tour` keeps a given order (the calm planner's, or its reverse when that is
-faster) and chooses the air headings at the targets for the least flight time: exact dynamic
-programming over candidate headings, as :mod:`.headings` does for length in calm air.  In calm
-air its times are the calm tour's Dubins lengths over the airspeed.
+:func:`plan_wind_tour` starts from a given order (the calm planner's, or its reverse when that
+is faster), chooses the air headings at the targets for the least flight time (exact dynamic
+programming over candidate headings, as :mod:`.headings` does for length in calm air, then each
+refined continuously), and improves the order on flight time (Or-opt moves; 2-opt's reversals
+would turn every heading of a run round in an asymmetric cost).  In calm air its times are the
+Dubins lengths over the airspeed, and with the calm tour's headings given, at most the calm tour's.
 """
 
 from __future__ import annotations
@@ -243,6 +245,7 @@ def _crab(ground: float, v: float, wx: float, wy: float) -> float:
 
 @numba.njit(cache=True)
 def _time(targets, a, ha, b, hb, rho, v, wx, wy, tol):
+    """:func:`_leg_time` from target ``a`` (air heading ``ha``) to target ``b`` (``hb``)."""
     return _leg_time(targets[a, 0], targets[a, 1], ha, targets[b, 0], targets[b, 1], hb, rho, v,
                      wx, wy, tol)
 
