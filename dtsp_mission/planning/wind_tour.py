@@ -216,23 +216,6 @@ class WindTour:
                            max(report.max_target_miss_m, gap))
 
 
-def crab_headings(ground_rad: np.ndarray, airspeed_m_s: float,
-                  wind_m_s: tuple[float, float]) -> np.ndarray:
-    """The air headings that make the aircraft track the ground directions ``ground_rad``
-    (the wind slower than the airspeed)."""
-    d = np.column_stack([np.cos(ground_rad), np.sin(ground_rad)])
-    w = np.asarray(wind_m_s, dtype=float)
-    across = w - (d @ w)[:, None] * d
-    along = np.sqrt(np.maximum(airspeed_m_s ** 2 - (across ** 2).sum(axis=1), 0.0))
-    air = along[:, None] * d - across
-    return np.arctan2(air[:, 1], air[:, 0])
-
-
-_GOLDEN = (math.sqrt(5.0) - 1.0) / 2.0
-#: A move of the order or a heading is kept only if it saves more than this (seconds).
-_GAIN_S = 1e-9
-
-
 @numba.njit(cache=True)
 def _crab(ground: float, v: float, wx: float, wy: float) -> float:
     """The air heading that tracks the ground direction ``ground``."""
@@ -241,6 +224,27 @@ def _crab(ground: float, v: float, wx: float, wy: float) -> float:
     ax, ay = wx - along_w * dx, wy - along_w * dy
     along = math.sqrt(max(v * v - ax * ax - ay * ay, 0.0))
     return math.atan2(along * dy - ay, along * dx - ax)
+
+
+@numba.njit(cache=True)
+def _crabs(ground: np.ndarray, v: float, wx: float, wy: float) -> np.ndarray:
+    out = np.empty_like(ground)
+    for i in range(len(ground)):
+        out[i] = _crab(ground[i], v, wx, wy)
+    return out
+
+
+def crab_headings(ground_rad: np.ndarray, airspeed_m_s: float,
+                  wind_m_s: tuple[float, float]) -> np.ndarray:
+    """The air headings that make the aircraft track the ground directions ``ground_rad``
+    (the wind slower than the airspeed)."""
+    ground = np.ascontiguousarray(ground_rad, dtype=float)
+    return _crabs(ground, float(airspeed_m_s), float(wind_m_s[0]), float(wind_m_s[1]))
+
+
+_GOLDEN = (math.sqrt(5.0) - 1.0) / 2.0
+#: A move of the order or a heading is kept only if it saves more than this (seconds).
+_GAIN_S = 1e-9
 
 
 @numba.njit(cache=True)
@@ -298,11 +302,11 @@ def _or_opt(targets, order, headings, neighbours, rho, v, wx, wy, tol, max_segme
     order = order.copy()
     headings = headings.copy()
     pos = np.empty(n, dtype=np.int64)
+    for k in range(n):
+        pos[order[k]] = k
     moves = 0
     options = np.empty(4)
     for _ in range(max_passes):
-        for k in range(n):
-            pos[order[k]] = k
         improved = False
         for length in range(1, max_segment + 1):
             if length > n - 3:
