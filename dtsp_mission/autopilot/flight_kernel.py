@@ -57,7 +57,9 @@ S_MEASURE_START = 22                                # the odometer when measurin
 S_XTRACK_I, S_LAST_WAYPOINT_UPDATE, S_LAST_NU = 23, 24, 25   # L1 integrator, its clock, last Nu
 S_SPEED_TARGET = 26                                 # the airspeed the autopilot holds
 S_COS_HEADING, S_SIN_HEADING = 27, 28               # cos and sin of S_HEADING, kept with it
-STATE_SIZE = 29
+S_TKO_EXCESS, S_TKO_END = 29, 30                    # airspeed over the target left by the climb-out,
+                                                    # and when the take-off ended
+STATE_SIZE = 31
 
 # -- the airframe vector -----------------------------------------------------------------------
 (A_AIRSPEED, A_L1_PERIOD, A_WP_RADIUS, A_ROLL_W, A_ROLL_Z, A_L1_DAMPING,
@@ -73,7 +75,10 @@ A_PX4, A_SWITCH_MULT = 20, 21
 # take-off run (0: ArduPlane's rule, lift-off at 85 % of cruise).
 A_SPEED_RATIO, A_SPEED_TC, A_TKO_SPEED = 22, 23, 24
 A_MAX_SPEED = 25                                     # the most airspeed it flies (0: no limit)
-AIRFRAME_SIZE = 26
+# ArduPlane SITL's climb-out: the airspeed the take-off ends at over the cruise airspeed (0:
+# the cruise airspeed at once), held this long (s), then bled off at this rate (m/s^2).
+A_TKO_END_RATIO, A_TKO_END_HOLD, A_TKO_END_DECAY = 26, 27, 28
+AIRFRAME_SIZE = 29
 
 LOITER_EXIT_HEADING_RAD = math.radians(10.0)
 TWO_PI = 2.0 * math.pi
@@ -513,6 +518,9 @@ def _step_takeoff(st, af, command, position, params, reached, counts, dt):
         st[S_ALT] = position[i, 2]
         if af[A_SPEED_TC] <= 0.0:
             st[S_AIRSPEED] = af[A_AIRSPEED]
+            if af[A_TKO_END_RATIO] > 0.0:
+                st[S_TKO_EXCESS] = (af[A_TKO_END_RATIO] - 1.0) * af[A_AIRSPEED]
+                st[S_TKO_END] = st[S_TIME]
         st[S_SPEED_TARGET] = af[A_AIRSPEED]
         _complete(st, af, command, position, params, reached, counts, 0.0, 0.0, 0.0, False)
 
@@ -542,6 +550,13 @@ def step(st, af, command, position, params, following, reached, counts, dt):
         return
     if af[A_SPEED_TC] > 0.0:
         st[S_AIRSPEED] += (st[S_SPEED_TARGET] - st[S_AIRSPEED]) * min(dt / af[A_SPEED_TC], 1.0)
+    elif st[S_TKO_EXCESS] > 0.0:         # the climb-out's airspeed bled off to the target
+        bled = af[A_TKO_END_DECAY] * max(st[S_TIME] - st[S_TKO_END] - af[A_TKO_END_HOLD], 0.0)
+        excess = st[S_TKO_EXCESS] - bled
+        if excess <= 0.0:
+            st[S_TKO_EXCESS] = 0.0
+            excess = 0.0
+        st[S_AIRSPEED] = st[S_SPEED_TARGET] + excess
     if c == NAV_LOITER_TURNS or c == NAV_LOITER_TIME:
         _step_loiter(st, af, command, position, params, following, reached, counts, dt)
         return
