@@ -78,7 +78,10 @@ A_MAX_SPEED = 25                                     # the most airspeed it flie
 # ArduPlane SITL's climb-out: the airspeed the take-off ends at over the cruise airspeed (0:
 # the cruise airspeed at once), held this long (s), then bled off at this rate (m/s^2).
 A_TKO_END_RATIO, A_TKO_END_HOLD, A_TKO_END_DECAY = 26, 27, 28
-AIRFRAME_SIZE = 29
+# ArduPlane SITL's airspeed in a bank: above the target by this much per unit of (1 / cos(bank)
+# - 1), the load factor's excess (m/s; 0: none).
+A_BANK_SPEED = 29
+AIRFRAME_SIZE = 30
 
 LOITER_EXIT_HEADING_RAD = math.radians(10.0)
 TWO_PI = 2.0 * math.pi
@@ -550,12 +553,16 @@ def step(st, af, command, position, params, following, reached, counts, dt):
         return
     if af[A_SPEED_TC] > 0.0:
         st[S_AIRSPEED] += (st[S_SPEED_TARGET] - st[S_AIRSPEED]) * min(dt / af[A_SPEED_TC], 1.0)
-    elif st[S_TKO_EXCESS] > 0.0:         # the climb-out's airspeed bled off to the target
-        bled = af[A_TKO_END_DECAY] * max(st[S_TIME] - st[S_TKO_END] - af[A_TKO_END_HOLD], 0.0)
-        excess = st[S_TKO_EXCESS] - bled
-        if excess <= 0.0:
-            st[S_TKO_EXCESS] = 0.0
-            excess = 0.0
+    elif st[S_TKO_EXCESS] > 0.0 or af[A_BANK_SPEED] > 0.0:
+        excess = 0.0
+        if st[S_TKO_EXCESS] > 0.0:        # the climb-out's airspeed bled off to the target
+            bled = af[A_TKO_END_DECAY] * max(st[S_TIME] - st[S_TKO_END] - af[A_TKO_END_HOLD], 0.0)
+            excess = st[S_TKO_EXCESS] - bled
+            if excess <= 0.0:
+                st[S_TKO_EXCESS] = 0.0
+                excess = 0.0
+        # faster in a bank (the load factor's excess), slower again as it levels
+        excess += af[A_BANK_SPEED] * (1.0 / math.cos(st[S_BANK]) - 1.0)
         st[S_AIRSPEED] = st[S_SPEED_TARGET] + excess
     if c == NAV_LOITER_TURNS or c == NAV_LOITER_TIME:
         _step_loiter(st, af, command, position, params, following, reached, counts, dt)

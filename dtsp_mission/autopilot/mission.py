@@ -9,6 +9,7 @@ rounds them with :func:`degrees_to_e7` -- in one place.
 from __future__ import annotations
 
 from dataclasses import dataclass
+from typing import Any
 
 from .commands import Autopilot, Command, Frame
 
@@ -97,6 +98,10 @@ class VehicleMission:
     #: the targets it was planned for, in visiting order (a plan file written by dtsp-mission
     #: carries them); empty: unknown
     targets: tuple[MissionTarget, ...] = ()
+    #: the navigation parameters of the aircraft the mission was designed for
+    #: (:class:`~dtsp_mission.autopilot.parameters.VehicleParameters` or ``PX4Parameters``;
+    #: a plan file written by dtsp-mission carries them); None: unknown
+    designed_for: Any = None
 
     def problems(self) -> list[str]:
         """What no autopilot would take, or no operator would fly, from this mission: a home or

@@ -173,11 +173,27 @@ def read_px4_parameters(path: str | os.PathLike) -> PX4Parameters:
     except OSError as error:
         raise FileAccessError(f"cannot read the vehicle parameters {path}: {error.strerror}") from None
     values = parse_parameters(text, str(path))
+    check_px4_parameters(values, str(path))
+    return PX4_DEFAULTS.with_values(values)
+
+
+def check_px4_parameters(values: dict[str, float], where: str = "parameters") -> None:
+    """:class:`FileFormatError` for a PX4 navigation parameter out of its range."""
     for name, (low, high) in PX4_RANGES.items():
         if name in values and not (math.isfinite(values[name]) and low <= values[name] <= high):
-            raise FileFormatError(f"{path}: {name} {values[name]:g} is out of its range "
+            raise FileFormatError(f"{where}: {name} {values[name]:g} is out of its range "
                                   f"{low:g} .. {high:g}")
-    return PX4_DEFAULTS.with_values(values)
+
+
+def checked_parameters(autopilot, values: dict[str, float], where: str = "parameters"
+                       ) -> VehicleParameters | PX4Parameters:
+    """``autopilot``'s stock navigation parameters with ``values`` laid over them, each
+    checked against its range (:class:`FileFormatError` naming ``where`` otherwise)."""
+    if autopilot == "px4" or autopilot == 12:
+        check_px4_parameters(values, where)
+        return PX4_DEFAULTS.with_values(values)
+    check_parameters(values, where)
+    return ARDUPLANE_DEFAULTS.with_values(values)
 
 
 def parameters_of(autopilot, given: VehicleParameters | PX4Parameters | None = None

@@ -39,16 +39,28 @@ def fly(mission_file, rho_m, airspeed_m_s, max_bank_deg, speedup, vehicle_params
     carries, or else the waypoints with an acceptance radius (how dtsp-mission writes the
     targets' waypoints; the guidance design aims them off the targets, so give --targets to
     measure what matters).
-    The aircraft navigates like an ArduPlane with --vehicle-params (a stock one without);
-    --radius or --max-bank limit its bank, --airspeed sets its cruise speed.
+    The aircraft is the one the plan was designed for (a .plan written by dtsp-mission
+    records its navigation parameters), else a stock one of the plan's autopilot;
+    --vehicle-params flies another, --radius or --max-bank limit its bank, --airspeed sets its
+    cruise speed (each said when it changes the designed aircraft).
 
-    Example: dtsp-mission fly mission.plan --radius 80 --airspeed 22
+    Example: dtsp-mission fly mission.plan
     """
     from ..export import read_mission
     console.start(quiet, as_json)
     mission = read_mission(mission_file, format_name)
-    airframe, _, _ = airframe_from(vehicle_params_file, airspeed_m_s, max_bank_deg, l1_period_s,
-                                   rho_m, mission.autopilot)
+    designed = None if vehicle_params_file else mission.designed_for
+    airframe, flown, _ = airframe_from(vehicle_params_file, airspeed_m_s, max_bank_deg, l1_period_s,
+                                       rho_m, mission.autopilot, base=designed)
+    if designed is not None:
+        changed = [f"{name} {theirs:g} (designed for {ours:g})"
+                   for name, ours, theirs in designed.differing(flown)]
+        if changed:
+            note("flying another aircraft than the plan was designed for: " + ", ".join(changed))
+    elif mission.designed_for is not None and mission.designed_for.differing(flown):
+        note("flying the aircraft of --vehicle-params, not the one the plan was designed for: "
+             + ", ".join(f"{n} {t:g} (designed for {o:g})"
+                         for n, o, t in mission.designed_for.differing(flown)))
     try:
         if targets_file is None:
             targets = targets_in(mission)

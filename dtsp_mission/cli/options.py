@@ -267,21 +267,24 @@ def progress_reporter(label: str):
 
 
 def airframe_from(vehicle_params_file, airspeed_m_s, max_bank_deg, l1_period_s,
-                  rho_m=None, autopilot="ardupilot"):
+                  rho_m=None, autopilot="ardupilot", base=None):
     """The simulated aircraft: an ArduPlane (or, for ``autopilot`` PX4, a PX4 flying PX4
     SITL's fixed wing) with the parameters of ``vehicle_params_file`` (a stock one without),
     overridden by the options given: ``--airspeed`` (cruise, PX4's trim), ``--max-bank`` (roll
     limit), ``--radius`` (a roll limit that turns no tighter than it), ``--l1-period`` (PX4's
-    NPFG_PERIOD); and the one-line description of it the commands print."""
+    NPFG_PERIOD); and the one-line description of it the commands print.  ``base``: the
+    parameters to start from without a file (a plan's designed aircraft; stock if None)."""
     from ..autopilot.commands import Autopilot
     from ..autopilot.navigation import Airframe, parameters_with
     from ..autopilot.parameters import ARDUPLANE_DEFAULTS
     origin = (f"parameters from {vehicle_params_file}" if vehicle_params_file
+              else "the parameters the plan was designed for" if base is not None
               else "stock parameters")
     if autopilot in ("px4", Autopilot.PX4):
         from ..autopilot.navigation import px4_parameters_with
         from ..autopilot.parameters import PX4_DEFAULTS
-        px4 = designed_for(vehicle_params_file, autopilot) or PX4_DEFAULTS
+        px4 = designed_for(vehicle_params_file, autopilot) or (
+            base if isinstance(base, type(PX4_DEFAULTS)) else PX4_DEFAULTS)
         px4 = px4_parameters_with(px4, airspeed_m_s, max_bank_deg, l1_period_s, rho_m)
         airframe = Airframe.from_px4_parameters(px4)
         source = (f"PX4 navigation (NPFG): {origin}, trim airspeed {px4.FW_AIRSPD_TRIM:g} m/s "
@@ -289,7 +292,8 @@ def airframe_from(vehicle_params_file, airspeed_m_s, max_bank_deg, l1_period_s,
                   f"roll limit {px4.FW_R_LIM:.0f} deg, NPFG_PERIOD {px4.NPFG_PERIOD:g} s, "
                   f"NAV_ACC_RAD {px4.NAV_ACC_RAD:g} m")
         return airframe, px4, source
-    parameters = designed_for(vehicle_params_file) or ARDUPLANE_DEFAULTS
+    parameters = designed_for(vehicle_params_file) or (
+        base if isinstance(base, type(ARDUPLANE_DEFAULTS)) else ARDUPLANE_DEFAULTS)
     parameters = parameters_with(parameters, airspeed_m_s, max_bank_deg, l1_period_s, rho_m)
     source = (f"ArduPlane navigation: {origin}, cruise {parameters.AIRSPEED_CRUISE:g} m/s, roll "
               f"limit {parameters.ROLL_LIMIT_DEG:.0f} deg, NAVL1_PERIOD "

@@ -68,6 +68,11 @@ def run_flight_check(mission, targets, airframe, via: str, speedup: float,
     finally:
         close()
     print_check(check)
+    if check.lost_reports:
+        raise click.ClickException(
+            f"{check.lost_reports} of the vehicle's {check.samples + check.lost_reports} position "
+            f"reports did not arrive (the link could not keep up at --speedup {speedup:g}): the "
+            "misses above are measured on a track with holes; fly again with a lower --speedup")
     if max_miss_m is not None and check.max_miss_m > max_miss_m:
         raise click.ClickException(f"a target was missed by {check.max_miss_m:.1f} m, more than "
                                    f"--max-miss {max_miss_m:g} m")

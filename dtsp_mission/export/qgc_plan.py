@@ -9,6 +9,7 @@ checks its own output against them before writing anything.
 
 from __future__ import annotations
 
+import dataclasses
 import json
 import math
 from typing import Any
@@ -17,6 +18,7 @@ from ..errors import FileFormatError, TourInvalidError
 from ..files import read_text
 from ..mission import Autopilot, Home, Mission, MissionItem, VehicleMission
 from ..autopilot.mission import MissionTarget
+from ..autopilot.parameters import checked_parameters
 from ..autopilot.commands import VEHICLE_TYPE_FIXED_WING
 from .base import Exporter
 
@@ -71,6 +73,10 @@ def plan_dict(mission: Mission) -> dict[str, Any]:
         for t in mission.visited_targets()]}
     if mission.guidance is not None:
         ours["designWind"] = mission.summary["design_wind"]
+    if mission.designed_for is not None:
+        # the aircraft the items were designed for, so that a flight check of the file flies it
+        ours["aircraft"] = {"parameters": {f.name: getattr(mission.designed_for, f.name)
+                                           for f in dataclasses.fields(mission.designed_for)}}
     document["dtspMission"] = ours
     return document
 
@@ -94,6 +100,22 @@ def _carried_targets(path, ours: dict) -> tuple[MissionTarget, ...]:
                                   "and an optional altitude_m)")
         targets.append(MissionTarget(fields["name"], float(lat), float(lon), float(altitude)))
     return tuple(targets)
+
+
+def _carried_aircraft(path, ours: dict, autopilot: Autopilot):
+    """The navigation parameters of the aircraft a plan was designed for (``dtspMission.
+    aircraft.parameters``), None if it does not say, :class:`FileFormatError` if it says
+    something that is not such parameters."""
+    aircraft = ours.get("aircraft")
+    if aircraft is None:
+        return None
+    values = aircraft.get("parameters") if isinstance(aircraft, dict) else None
+    if not isinstance(values, dict) or not all(isinstance(k, str) and _is_number(v)
+                                               for k, v in values.items()):
+        raise FileFormatError(f"{path}: dtspMission.aircraft.parameters is not a set of "
+                              "navigation parameters (NAME: number)")
+    return checked_parameters(int(autopilot), {k: float(v) for k, v in values.items()},
+                              f"{path}: dtspMission.aircraft")
 
 
 def _is_number(value: Any) -> bool:
@@ -241,7 +263,8 @@ class QGCPlanExporter(Exporter):
             design_wind = (float(wind["speed_m_s"]), float(wind["from_deg"]))
         read = VehicleMission(tuple(items), Home(*mission["plannedHomePosition"]), autopilot,
                               design_wind=design_wind, not_carried=_beside_the_items(data),
-                              targets=_carried_targets(path, ours))
+                              targets=_carried_targets(path, ours),
+                              designed_for=_carried_aircraft(path, ours, autopilot))
         problems = read.problems()
         if problems:
             raise FileFormatError(f"{path}: " + "; ".join(problems[:3]))

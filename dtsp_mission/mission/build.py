@@ -195,7 +195,7 @@ def build_mission(tour: Tour, frame: LocalFrame, targets: GeoTargets,
                       autopilot, settings.airspeed_m_s, tour.rho_m, tolerance, frame, tour, path,
                       targets.names, tuple(notes), summary,
                       (np.asarray(targets.latitudes_deg), np.asarray(targets.longitudes_deg)),
-                      guidance)
+                      guidance, parameters_of(settings.autopilot, settings.vehicle))
     summary["vehicle_slots"] = mission.vehicle_item_count()
     return mission
 

@@ -135,6 +135,9 @@ class Mission:
     summary: dict[str, Any] = field(default_factory=dict)
     targets_deg: tuple[np.ndarray, np.ndarray] | None = None   # the input's latitudes, longitudes
     guidance: GuidancePrediction | None = None
+    #: the navigation parameters of the aircraft it was designed for (VehicleParameters or
+    #: PX4Parameters); carried to the vehicle mission and the .plan
+    designed_for: Any = None
 
     @property
     def target_items(self) -> list[int]:
@@ -171,7 +174,7 @@ class Mission:
         """The mission as a vehicle receives it, with the design wind and the targets."""
         return VehicleMission(self.items, self.home, self.autopilot,
                               design_wind=None if self.guidance is None else self.guidance.design_wind,
-                              targets=self.visited_targets())
+                              targets=self.visited_targets(), designed_for=self.designed_for)
 
     def vehicle_item_count(self) -> int:
         """Mission slots on the vehicle: the items plus ArduPilot's home at seq 0."""

@@ -144,6 +144,9 @@ class FlightCheck:
     min_turn_radius_m: float           # smallest radius seen in the telemetry (1 s windows)
     samples: int
     airframe: Airframe
+    #: position reports the vehicle sent that did not arrive (gaps in their vehicle time):
+    #: where this is not 0 the misses are measured on a track with holes
+    lost_reports: int = 0
 
     @property
     def max_miss_m(self) -> float:
@@ -183,17 +186,18 @@ def fly_mission(mission: VehicleMission, targets: Targets, airframe: Airframe,
     return FlightCheck(report, reached == items - 1, flight_time, reached + 1, items, miss,
                        altitude_error, targets.names, _min_turn_radius(local_track, track[:, 3:5],
                                                                        telemetry_hz),
-                       len(track), airframe)
+                       len(track), airframe, lost_reports(track[:, 5], telemetry_hz))
 
 
 def _watch(vehicle: SimulatedVehicle, connection: str, mission: VehicleMission, speedup: float,
            progress, timeout_s: float | None) -> tuple[np.ndarray, int]:
     """Start the mission with MAV_CMD_MISSION_START and record the telemetry until the last
-    item is reached; returns rows (lat, lon, relative alt, v_north, v_east) and the highest
-    seq reached."""
+    item is reached; returns rows (lat, lon, relative alt, v_north, v_east, vehicle time s)
+    and the highest seq reached."""
     use_mavlink2()
     link = mavutil.mavlink_connection(connection, source_system=GCS_SYSTEM_ID,
                                       source_component=GCS_COMPONENT_ID)
+    _widen_receive_buffer(link)
     rows = []
     highest = -1
     last_seq = len(vehicle.mission) - 1
@@ -228,14 +232,35 @@ def _watch(vehicle: SimulatedVehicle, connection: str, mission: VehicleMission, 
             last_heard = time.monotonic()
             if message.get_type() == "GLOBAL_POSITION_INT":
                 rows.append((message.lat / 1e7, message.lon / 1e7, message.relative_alt / 1e3,
-                             message.vx / 100.0, message.vy / 100.0))
+                             message.vx / 100.0, message.vy / 100.0, message.time_boot_ms / 1e3))
             elif message.seq > highest:
                 highest = message.seq
                 if progress is not None:
                     progress("flight", highest, last_seq)
     finally:
         link.close()
-    return np.array(rows).reshape(-1, 5), highest
+    return np.array(rows).reshape(-1, 6), highest
+
+
+def lost_reports(times_s: np.ndarray, rate_hz: float) -> int:
+    """How many reports sent every ``1 / rate_hz`` s of vehicle time are missing from
+    ``times_s`` (received, in order)."""
+    if len(times_s) < 2:
+        return 0
+    gaps = np.diff(np.asarray(times_s, dtype=float)) * rate_hz
+    return int(np.maximum(np.round(gaps) - 1.0, 0.0).sum())
+
+
+def _widen_receive_buffer(link) -> None:
+    """Room for a few seconds of telemetry in the socket, so that a ground station busy for a
+    moment loses nothing (the kernel caps what it grants)."""
+    import socket
+    port = getattr(link, "port", None)
+    if isinstance(port, socket.socket):
+        try:
+            port.setsockopt(socket.SOL_SOCKET, socket.SO_RCVBUF, 8 << 20)
+        except OSError:
+            pass
 
 
 def _min_turn_radius(track_m: np.ndarray, velocity_ne: np.ndarray, rate_hz: float) -> float:

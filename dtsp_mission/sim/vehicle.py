@@ -50,6 +50,12 @@ from ..vehicle import heading_to_bearing_deg
 SIGNING_EPOCH_S = 1420070400     # MAVLink 2 signing timestamps count from 2015-01-01
 
 
+#: With speedup 0 the flight runs as fast as a ground station can take its position
+#: reports: at most this many per wall second (beyond it, UDP drops them and the track has
+#: holes; ``fly`` checks for them).
+FASTEST_TELEMETRY_PER_S = 1500.0
+
+
 @dataclass(frozen=True)
 class VehicleSettings:
     """The simulated vehicle: where it stands, how it flies, and the faults it shows."""
@@ -57,7 +63,8 @@ class VehicleSettings:
     home: Home
     autopilot: Autopilot = Autopilot.ARDUPILOTMEGA
     airframe: Airframe = Airframe()
-    speedup: float = 50.0             # simulated seconds per wall second; 0: as fast as possible
+    speedup: float = 50.0             # simulated seconds per wall second; 0: as fast as the
+                                      # telemetry is carried (FASTEST_TELEMETRY_PER_S)
     step_s: float = MODEL_STEP_S
     telemetry_hz: float = 10.0        # position messages per simulated second
     max_items: int | None = None      # mission slots (home included on ArduPilot); None: a
@@ -412,8 +419,10 @@ class SimulatedVehicle:
                     self._publish(state, flight.ground_velocity_m_s)
                 if flight.finished:
                     self.finished.set()
-            if settings.speedup > 0:
-                ahead = (state.time_s - paced_from[1]) / settings.speedup \
+            pace = settings.speedup if settings.speedup > 0 else \
+                FASTEST_TELEMETRY_PER_S / settings.telemetry_hz
+            if pace > 0:
+                ahead = (state.time_s - paced_from[1]) / pace \
                     - (time.monotonic() - paced_from[0])
                 if ahead > 0.002:
                     time.sleep(ahead)

@@ -76,8 +76,10 @@ def designed_parameters(mission: VehicleMission,
                         designed_for: VehicleParameters | PX4Parameters | None = None
                         ) -> VehicleParameters | PX4Parameters:
     """The navigation parameters ``mission`` was designed for: ``designed_for`` if it is its
-    autopilot's, else that autopilot's stock values."""
-    return parameters_of(mission.autopilot, designed_for)
+    autopilot's, else those the mission records (a .plan written by dtsp-mission), else that
+    autopilot's stock values."""
+    return parameters_of(mission.autopilot, designed_for if designed_for is not None
+                         else mission.designed_for)
 
 
 def vehicle_warnings(mission: VehicleMission, info: VehicleInfo,

@@ -134,13 +134,15 @@ def test_the_wind_blows_from_where_it_is_said_to():
 def test_the_aircraft_turns_at_the_radius_its_airframe_says(airspeed, rho):
     """One answer to "what radius does this aircraft turn": asked to loiter on a circle
     tighter than it can fly, the aircraft made to turn no tighter than ``rho`` turns at its
-    roll limit, on arcs of exactly ``Airframe.turn_radius_m`` at that bank -- which is ``rho``
+    roll limit (and the airspeed it flies at that bank), on arcs of exactly
+    ``Airframe.turn_radius_m`` at that bank -- which is ``rho``
     -- measured on the track (distance flown over the course turned, 1 s windows)."""
     assert Airframe() == Airframe.from_parameters()           # the default is the shipped aircraft
     airframe = Airframe.turning_at(rho, airspeed)
     bank = math.radians(airframe.roll_limit_deg)
+    faster = airspeed + 1.0 * (1.0 / math.cos(bank) - 1.0)              # 1 m/s per load excess
     assert airframe.turn_radius_m(airframe.roll_limit_deg) == pytest.approx(
-        airspeed ** 2 / (0.73 * 9.80665 * math.tan(bank)), rel=1e-12)   # 0.73 of the coordinated rate
+        faster ** 2 / (0.70 * 9.80665 * math.tan(bank)), rel=1e-12)    # 0.70 of the coordinated rate
     assert airframe.tightest_turn_m == pytest.approx(rho, rel=1e-12)
     assert airframe.turn_radius_m(airframe.roll_limit_deg) == pytest.approx(rho, rel=1e-12)
     items = _mission([(400.0, 0.0)], loiter=(1200.0, 0.0, 6.0, 0.3 * rho))

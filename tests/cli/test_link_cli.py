@@ -236,3 +236,47 @@ def test_a_waypoints_file_sent_to_px4_is_said_to_be_sent_as_a_px4_mission(missio
     assert "does not say its autopilot" in result.output and "PX4" in result.output
     assert "(and a home slot if the vehicle is ArduPilot)" in result.output
     assert vehicle.mission[0].command == 22          # no home slot: take-off first
+
+
+def test_fly_flies_the_aircraft_the_plan_was_designed_for(tmp_path):
+    """A .plan records the navigation parameters it was designed for; `fly` flies them
+    without being told (here a tuned NAVL1_PERIOD 18), says when an option flies another
+    aircraft (--radius limits the bank), and `upload` compares the vehicle with them."""
+    parm = tmp_path / "tuned.parm"
+    parm.write_text("NAVL1_PERIOD 18\nWP_RADIUS 60\n")
+    csv = tmp_path / "t.csv"
+    csv.write_text("lat,lon\n46.80,6.950\n46.805,6.955\n46.801,6.962\n46.796,6.957\n")
+    plan = tmp_path / "m.plan"
+    done = subprocess.run([sys.executable, "-m", "dtsp_mission.cli", "plan", str(csv), "--radius",
+                           "80", "--alt", "100", "--airspeed", "22", "--vehicle-params", str(parm),
+                           "-q", "-o", str(plan)], capture_output=True, text=True, timeout=240)
+    assert done.returncode == 0, done.stderr
+    stored = exporter_for(plan).read(plan)
+    assert stored.designed_for.NAVL1_PERIOD == 18 and stored.designed_for.WP_RADIUS == 60
+    flown = subprocess.run([sys.executable, "-m", "dtsp_mission.cli", "fly", str(plan),
+                            "--speedup", "400"], capture_output=True, text=True, timeout=240)
+    assert flown.returncode == 0, flown.stderr
+    assert "L1 period 18 s" in flown.stdout and "another aircraft" not in flown.stderr
+    other = subprocess.run([sys.executable, "-m", "dtsp_mission.cli", "fly", str(plan),
+                            "--speedup", "400", "--radius", "80"],
+                           capture_output=True, text=True, timeout=240)
+    assert other.returncode == 0, other.stderr
+    assert "flying another aircraft than the plan was designed for: ROLL_LIMIT_DEG" in other.stderr
+    assert "(designed for 65)" in other.stderr
+
+
+def test_fly_as_fast_as_possible_loses_no_position_report(mission, tmp_path):
+    """--speedup 0 is paced to what the link carries: every report the vehicle sends arrives,
+    and the misses are those of the whole flight."""
+    from dtsp_mission.sim.fly import fly_mission, planned_targets
+    check = fly_mission(mission.for_vehicle(), planned_targets(mission),
+                        Airframe.from_parameters(airspeed_m_s=20.0), speedup=0.0)
+    assert check.completed and check.lost_reports == 0
+    assert check.samples >= 10 * check.flight_time_s * 0.95     # 10 Hz of the whole flight
+
+
+def test_lost_position_reports_are_counted():
+    from dtsp_mission.sim.fly import lost_reports
+    assert lost_reports([0.0, 0.1, 0.2, 0.3], 10.0) == 0
+    assert lost_reports([0.0, 0.1, 0.5, 0.6, 1.0], 10.0) == 3 + 3
+    assert lost_reports([], 10.0) == 0

@@ -116,7 +116,7 @@ def test_random_targets_in_a_polygon_are_seeded(tmp_path):
     result = run(*common, "--seed", "5", "-o", other)
     assert result.returncode == 0, result.stderr
     # the radius the flight model's aircraft turns at that bank: 20^2 / (0.73 g tan 30 deg)
-    assert "rho 96.8 m: the aircraft's turn at 20 m/s and 30 deg bank" in result.stdout
+    assert "rho 102.5 m: the aircraft's turn at 20 m/s and 30 deg bank" in result.stdout
     assert first.read_text() == second.read_text() != other.read_text()
     assert "\t21\t" in first.read_text().splitlines()[-1]      # PX4 default: a landing
 
@@ -192,11 +192,12 @@ def test_sanity_checks_refuse_or_warn_with_a_clear_message(tmp_path):
     targets = tmp_path / "t.csv"
     targets.write_text("lat,lon\n46.80,6.94\n46.81,6.95\n46.805,6.955\n")
     steep = run(targets, "--radius", 5, "--airspeed", 22)
-    # the smallest radius named is the one the flight model flies: 22^2 / (0.73 g tan 65 deg)
+    # the smallest radius named is the one the flight model flies: v^2 / (0.70 g tan 65 deg),
+    # v = 22 m/s + 1 m/s x (1 / cos 65 deg - 1), the airspeed it flies at that bank
     assert steep.returncode == 2 and "cannot turn at 5 m: at 22 m/s with a roll limit of 65 deg" \
-        in steep.stderr and "no tighter than 32 m" in steep.stderr
-    assert run(targets, "--radius", 31, "--airspeed", 22, "-o", tmp_path / "t.json").returncode == 2
-    assert run(targets, "--radius", 32, "--airspeed", 22, "-o", tmp_path / "t.json").returncode == 0
+        in steep.stderr and "no tighter than 38 m" in steep.stderr
+    assert run(targets, "--radius", 37, "--airspeed", 22, "-o", tmp_path / "t.json").returncode == 2
+    assert run(targets, "--radius", 38, "--airspeed", 22, "-o", tmp_path / "t.json").returncode == 0
     high = run(targets, "--radius", 80, "--alt", 50000)
     assert high.returncode == 2 and "altitude 50000 m above home is beyond 10000 m" in high.stderr
     assert "needs --airspeed" in run(targets, "--radius", 80, "--endurance", 10).stderr
