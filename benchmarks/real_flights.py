@@ -154,8 +154,6 @@ def run_case(case: str, binaries) -> tuple[dict, list[dict]]:
     mission = read_mission(str(plan_file), None)
     wind = _wind(wind_text)
     parameters = dict(TUNINGS[tuning])
-    if autopilot == "px4":
-        parameters.setdefault("MIS_TKO_LAND_REQ", 0)
     flight = fly_real(mission, binaries, parameters, wind)
     # the real track and the mission flown, for looking into a case afterwards (not committed)
     np.savez_compressed(CACHE / (case.replace("/", "_") + ".track.npz"), track=flight.track,

@@ -87,8 +87,11 @@ def _prepare(tour: Tour, frame: LocalFrame, targets: GeoTargets,
     if loiters and settings.autopilot == "px4" and settings.airspeed_m_s is None:
         raise InputError("a PX4 loiter is given in seconds (NAV_LOITER_TIME): give the airspeed "
                          "(`airspeed_m_s`) so that the turns can be timed")
+    # the first target beyond the climb-out and two L1 distances of settling after it
+    airframe = settings.design_airframe()
+    settle = 2.0 * airframe.l1_distance_m(airframe.airspeed_m_s)
     path = plan_flight_path(tour, home_m, settings.altitude_m, settings.return_mode, launch,
-                            landing, altitudes, loiters)
+                            landing, altitudes, loiters, settle)
     at_targets = action_items_of(path, frame, targets, actions, settings)
     notes += _steep_steps(path, targets, settings)
     launch_heading = path.chain.starts[0, 2]

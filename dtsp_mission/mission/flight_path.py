@@ -39,8 +39,11 @@ def approach(altitude_m: float) -> tuple[float, float]:
     return height, height / math.tan(math.radians(LANDING_GLIDE_DEG))
 
 
-def _open_at(tour: Tour, home_m: np.ndarray, returns_home: bool) -> tuple[int, np.ndarray]:
-    """Position (in visit order) of the target the opened tour starts with, and the order."""
+def _open_at(tour: Tour, home_m: np.ndarray, returns_home: bool,
+             first_beyond_m: float = 0.0) -> tuple[int, np.ndarray]:
+    """Position (in visit order) of the target the opened tour starts with, and the order:
+    the opening that saves the most, among targets at least ``first_beyond_m`` from home
+    where there are any."""
     order = tour.visit_order
     visits = tour.visit_s_m[order]
     points = tour.targets_m[order]
@@ -48,7 +51,11 @@ def _open_at(tour: Tour, home_m: np.ndarray, returns_home: bool) -> tuple[int, n
     gaps[0] += tour.length_m
     entry = np.hypot(*(points - home_m).T)
     back = np.roll(entry, 1) if returns_home else 0.0
-    return int(np.argmin(entry + back - gaps)), order
+    cost = entry + back - gaps
+    far = entry >= first_beyond_m
+    if far.any():
+        cost = np.where(far, cost, np.inf)
+    return int(np.argmin(cost)), order
 
 
 def _unit(heading_rad: float) -> np.ndarray:
@@ -59,18 +66,23 @@ def plan_flight_path(tour: Tour, home_m: np.ndarray, cruise_altitude_m: float,
                      return_mode: str, launch_heading_rad: float | None = None,
                      landing_heading_rad: float | None = None,
                      target_altitudes_m: np.ndarray | None = None,
-                     loiters: dict[int, tuple[int, float]] | None = None) -> FlightPath:
+                     loiters: dict[int, tuple[int, float]] | None = None,
+                     settle_m: float = 0.0) -> FlightPath:
     """The path from the end of the climb-out over every target (in tour order) to the end of
     the mission: the last target for ``rtl``/``none``, the approach point for ``land``.
     ``loiters`` (target -> (turns, radius)) adds whole circles through those targets.
 
     ``launch_heading_rad`` defaults to the direction from home to the first target and
-    ``landing_heading_rad`` to the launch heading (same runway, same wind).
+    ``landing_heading_rad`` to the launch heading (same runway, same wind).  The first target
+    is one at least ``settle_m`` beyond the end of the climb-out where there is one: the real
+    autopilots' climb-out (faster than cruise, the first turn) is what the flight model
+    predicts worst, so no target is passed before the aircraft has settled.
     """
     home = np.asarray(home_m, dtype=float).reshape(2)
     rho = tour.rho_m
     length = tour.length_m
-    first, order = _open_at(tour, home, return_mode != "none")
+    first, order = _open_at(tour, home, return_mode != "none",
+                            climb_distance_m(cruise_altitude_m) + settle_m if settle_m > 0 else 0.0)
     visits = tour.visit_s_m[order]
     start_s, end_s = visits[first], visits[first - 1]
     # Forward from the first target to the last, wrapping past the end of the chain; with a

@@ -191,7 +191,7 @@ def _fly(connection: str, px4: bool, first: int, last: int, budget_s: float, say
                                    GLOBAL_POSITION_INT_ID, 100_000, 0, 0, 0, 0, 0)
         mode = PX4_AUTO_MISSION if px4 else ARDUPLANE_AUTO
         deadline = time.monotonic() + budget_s
-        held, armed, last_command, last_heartbeat, done_at = 0, False, 0.0, 0.0, None
+        held, away, armed, last_command, last_heartbeat, done_at = 0, 0, False, 0.0, 0.0, None
         while True:
             wall = time.monotonic()
             if wall > deadline:
@@ -221,12 +221,15 @@ def _fly(connection: str, px4: bool, first: int, last: int, budget_s: float, say
             if kind == "HEARTBEAT":
                 if message.get_srcComponent() != 1 or message.type == 6:
                     continue
-                in_mode = message.custom_mode == mode
+                in_mode = (message.custom_mode == mode if not px4 else
+                           (message.custom_mode >> 16) & 0xFF == 4           # AUTO, and
+                           and (message.custom_mode >> 24) in (2, 4))      # TAKEOFF or MISSION
                 held = held + 1 if in_mode else 0
+                away = 0 if in_mode else away + 1
                 if message.base_mode & ARMED_FLAG and not armed:
                     armed = True
                     say("armed in AUTO")
-                if armed and not in_mode and done_at is None:
+                if armed and away >= 2 and done_at is None:
                     # ArduPlane switches to RTL as the mission's last item, sometimes before
                     # the last waypoint's MISSION_ITEM_REACHED arrives: record a little more
                     done_at = now_s

@@ -80,38 +80,81 @@ class ArduPlaneSitl:
 
 class Px4Sitl:
     """``with Px4Sitl(folder, settings) as sitl:`` -- ``sitl.connection`` is the ground
-    station's UDP port PX4 sends to (bind it with udpin)."""
+    station's UDP port PX4 sends to, 14550 + the instance (bind it with udpin).
+
+    Started as the build's ``start.sh`` starts it (a fresh run directory with PX4's start-up
+    scripts, ``PX4_PARAM_*`` applied after the airframe's defaults), but done here: the
+    build's ``px4-*`` command links may have been copied as plain files (then every ``param``
+    command of the start-up fails and no airframe is loaded), so they are made again as links
+    to the ``px4`` binary."""
 
     autopilot = "px4"
+    AIRFRAME = "10041"            # sihsim_airplane
 
     def __init__(self, folder: Path, settings: SitlSettings) -> None:
         self.folder, self.settings = Path(folder), settings
         self.connection = f"udpin:127.0.0.1:{14550 + settings.instance}"
-        self._run: str | None = None
-        self._runs = tempfile.mkdtemp(prefix="dtsp-px4-")
+        self._run: Path | None = None
+        self._process: subprocess.Popen | None = None
 
     def __enter__(self) -> "Px4Sitl":
         s = self.settings
+        if s.wind.speed_m_s > 0:
+            raise LinkError("PX4's SIH (v1.16) has no wind: fly PX4 in calm air")
+        run = self._run = Path(tempfile.mkdtemp(prefix="dtsp-px4-"))
+        shutil.copytree(self.folder / "etc", run / "etc")
+        for path in (run / "etc").rglob("*"):
+            path.chmod(path.stat().st_mode | 0o200)
+        (run / "bin").mkdir()
+        binary = self.folder / "bin" / "px4"
+        (run / "bin" / "px4").symlink_to(binary)
+        for command in (self.folder / "bin").glob("px4-*"):
+            if command.name.endswith(".sh"):
+                shutil.copy(command, run / "bin" / command.name)
+            else:
+                (run / "bin" / command.name).symlink_to(binary)
+        links = run / "etc" / "init.d-posix" / "px4-rc.mavlink"
+        text = links.read_text()
+        ground = "mavlink start -x -u $udp_gcs_port_local -r 4000000 -f"
+        if ground not in text:
+            raise LinkError(f"PX4 SITL: {links.name} is not the one this driver knows")
+        # the ground station's port follows the instance (PX4 sends to 14550 for every one)
+        links.write_text(text.replace(ground, ground + " -o $((14550+px4_instance))", 1))
+        simulator = run / "etc" / "init.d-posix" / "px4-rc.simulator"
+        text = simulator.read_text()
+        anchor = 'if [ "$PX4_SIMULATOR" = "sihsim" ]'
+        if anchor not in text:
+            raise LinkError(f"PX4 SITL: {simulator.name} is not the one this driver knows")
+        apply = ('env | while IFS="=" read -r line; do name=${line%%=*}; case $name in '
+                 'PX4_PARAM_*) param set "${name#PX4_PARAM_}" "${line#*=}" ;; esac; done\n\n')
+        simulator.write_text(text.replace(anchor, apply + anchor, 1))
         env = dict(os.environ, PX4_HOME_LAT=f"{s.latitude_deg:.8f}",
                    PX4_HOME_LON=f"{s.longitude_deg:.8f}", PX4_HOME_ALT=f"{s.altitude_amsl_m:.2f}",
-                   PX4_SIM_SPEED_FACTOR=f"{s.speedup:g}", PX4_INSTANCE=str(s.instance),
-                   PX4_RUNS=self._runs)
-        parameters = dict(s.parameters)
-        if s.wind.speed_m_s > 0:
-            raise LinkError("PX4's SIH takes no steady wind here: fly PX4 in calm air")
-        for name, value in parameters.items():
+                   PX4_SIM_SPEED_FACTOR=f"{s.speedup:g}", PX4_SYS_AUTOSTART=self.AIRFRAME,
+                   PX4_SIMULATOR="sihsim", PX4_SIM_MODEL="sihsim_airplane",
+                   PATH=f"{run / 'bin'}{os.pathsep}{os.environ.get('PATH', '')}")
+        for name, value in s.parameters.items():
             env[f"PX4_PARAM_{name}"] = f"{value:g}"
-        done = subprocess.run([str(self.folder / "start.sh")], env=env, capture_output=True,
-                              text=True, timeout=60)
-        if done.returncode != 0 or len(done.stdout.split()) != 2:
-            raise LinkError(f"PX4 SITL did not start: {done.stderr.strip() or done.stdout.strip()}")
-        self._run = done.stdout.split()[1]
+        self._process = subprocess.Popen(
+            [str(run / "bin" / "px4"), "-d", "-i", str(s.instance), "-w", str(run), str(run)],
+            cwd=run, env=env, stdin=subprocess.DEVNULL, stdout=open(run / "px4.log", "wb"),
+            stderr=subprocess.STDOUT, start_new_session=True)
+        time.sleep(0.5)
+        if self._process.poll() is not None:
+            raise LinkError("PX4 SITL ended at start: "
+                            + (run / "px4.log").read_text(errors="replace")[-500:])
         return self
 
+    def log_tail(self) -> str:
+        """The end of PX4's console output (for an error message)."""
+        if self._run is None or not (self._run / "px4.log").exists():
+            return ""
+        return (self._run / "px4.log").read_text(errors="replace")[-400:]
+
     def __exit__(self, *exc) -> None:
+        _end(self._process)
         if self._run is not None:
-            subprocess.run([str(self.folder / "stop.sh"), self._run], capture_output=True, timeout=30)
-        shutil.rmtree(self._runs, ignore_errors=True)
+            shutil.rmtree(self._run, ignore_errors=True)
 
 
 def _wait_for_port(port: int, process: subprocess.Popen, log: Path, timeout_s: float) -> None:
