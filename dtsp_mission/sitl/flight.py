@@ -54,10 +54,7 @@ class RealFlight:
 
     def window(self) -> np.ndarray:
         """The track's (x, y) from the take-off item's completion to the last waypoint's."""
-        start = self.reached.get(self.first_seq, self.track[0, 0] if len(self.track) else 0.0)
-        end = self.reached.get(self.last_seq, math.inf)
-        keep = (self.track[:, 0] >= start) & (self.track[:, 0] <= end)
-        return self.track[keep, 1:3]
+        return measured_span(self.track, self.reached, self.first_seq, self.last_seq)
 
     @property
     def completed(self) -> bool:
@@ -76,6 +73,15 @@ class RealFlight:
         """Ground distance of :meth:`window`."""
         xy = self.window()
         return float(np.hypot(*np.diff(xy, axis=0).T).sum()) if len(xy) > 1 else 0.0
+
+
+def measured_span(track: np.ndarray, reached: dict[int, float], first: int, last: int) -> np.ndarray:
+    """(x, y) of the track rows (time, x, y, ...) from the reaching of ``first`` (the take-off
+    item; the start if it was not reached) to that of ``last`` (the end if not reached)."""
+    start = reached.get(first, track[0, 0] if len(track) else 0.0)
+    end = reached.get(last, math.inf)
+    keep = (track[:, 0] >= start) & (track[:, 0] <= end)
+    return track[keep, 1:3]
 
 
 def mission_seqs(mission: VehicleMission) -> tuple[int, int]:
@@ -124,6 +130,7 @@ def fly_real(mission: VehicleMission, binaries: SitlBinaries, parameters: dict[s
         report = upload_mission(mission, sitl.connection, heartbeat_timeout_s=60.0)
         say(f"uploaded {report.items} items, verified: {report.verified}")
         from ..sim.fly import estimated_flight_m
+        # the flight's length straight through the items, at a slow 15 m/s (loiters at 80 m)
         estimate_s = estimated_flight_m(mission, 80.0) / 15.0
         budget = timeout_s or 120.0 + 2.0 * estimate_s / speedup
         track, reached = _fly(sitl.connection, px4, first, last, budget, say)
@@ -283,13 +290,10 @@ def compare_with_model(mission: VehicleMission, flight: RealFlight, airframe: Ai
     points = flight.frame.to_local(targets.latitudes_deg, targets.longitudes_deg)
     real = closest_approach_m(flight.window(), points)
     predicted = predict_flight(mission, airframe, wind=wind)
-    track = predicted.track
-    start = predicted.reached.get(flight.first_seq, 0.0)
-    end = predicted.reached.get(flight.last_seq, math.inf)
-    keep = (track[:, 0] >= start) & (track[:, 0] <= end)
-    model_xy = track[keep, 1:3]
+    model_xy = measured_span(predicted.track, predicted.reached, flight.first_seq, flight.last_seq)
     model = closest_approach_m(model_xy, points)
     model_flown = float(np.hypot(*np.diff(model_xy, axis=0).T).sum()) if len(model_xy) > 1 else 0.0
-    model_time = end - start if math.isfinite(end) else math.nan
+    model_time = (predicted.reached[flight.last_seq] - predicted.reached.get(flight.first_seq, 0.0)
+                  if flight.last_seq in predicted.reached else math.nan)
     return TargetReport(targets.names, real, model, flight.flown_m, model_flown,
                         flight.flight_time_s, model_time)
