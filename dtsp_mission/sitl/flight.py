@@ -29,7 +29,6 @@ from .processes import ArduPlaneSitl, Px4Sitl, SitlSettings
 
 _FLOWN = (Command.NAV_WAYPOINT, Command.NAV_LOITER_TURNS, Command.NAV_LOITER_TIME)
 ARDUPLANE_AUTO = 10
-PX4_AUTO_MISSION = (4 << 16) | (4 << 24)
 MAV_CMD_DO_SET_MODE, MAV_CMD_COMPONENT_ARM_DISARM, MAV_CMD_SET_MESSAGE_INTERVAL = 176, 400, 511
 GLOBAL_POSITION_INT_ID = 33
 ARMED_FLAG = 128
@@ -126,7 +125,7 @@ def fly_real(mission: VehicleMission, binaries: SitlBinaries, parameters: dict[s
     say = progress or (lambda _m: None)
     with sitl:
         say(f"{kind} SITL started")
-        _wait_ready(sitl.connection, px4)
+        _wait_ready(sitl.connection)
         report = upload_mission(mission, sitl.connection, heartbeat_timeout_s=60.0)
         say(f"uploaded {report.items} items, verified: {report.verified}")
         from ..sim.fly import estimated_flight_m
@@ -165,7 +164,7 @@ def _vehicle_heartbeat(link, timeout_s: float):
     return None
 
 
-def _wait_ready(connection: str, px4: bool) -> None:
+def _wait_ready(connection: str) -> None:
     """Until the autopilot's heartbeat says STANDBY (booted, calibrated)."""
     link = _link(connection)
     try:
@@ -188,7 +187,6 @@ def _fly(connection: str, px4: bool, first: int, last: int, budget_s: float, say
     reached: dict[int, float] = {}
     now_s = 0.0
     try:
-        target = link.target_system or 1
         link.mav.heartbeat_send(6, 8, 0, 0, 0)
         beat = _vehicle_heartbeat(link, 20.0)
         if beat is None:
@@ -196,7 +194,6 @@ def _fly(connection: str, px4: bool, first: int, last: int, budget_s: float, say
         target = beat.get_srcSystem()
         link.mav.command_long_send(target, 1, MAV_CMD_SET_MESSAGE_INTERVAL, 0,
                                    GLOBAL_POSITION_INT_ID, 100_000, 0, 0, 0, 0, 0)
-        mode = PX4_AUTO_MISSION if px4 else ARDUPLANE_AUTO
         deadline = time.monotonic() + budget_s
         held, away, armed, last_command, last_heartbeat, done_at = 0, 0, False, 0.0, 0.0, None
         while True:
@@ -228,7 +225,7 @@ def _fly(connection: str, px4: bool, first: int, last: int, budget_s: float, say
             if kind == "HEARTBEAT":
                 if message.get_srcComponent() != 1 or message.type == 6:
                     continue
-                in_mode = (message.custom_mode == mode if not px4 else
+                in_mode = (message.custom_mode == ARDUPLANE_AUTO if not px4 else
                            (message.custom_mode >> 16) & 0xFF == 4           # AUTO, and
                            and (message.custom_mode >> 24) in (2, 4))      # TAKEOFF or MISSION
                 held = held + 1 if in_mode else 0
