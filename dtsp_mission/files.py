@@ -48,6 +48,26 @@ def read_text(path: str | os.PathLike) -> str:
                               f"{error.start})") from None
 
 
+def parse_json(text: str, where: str):
+    """The JSON document in ``text``, or :class:`FileFormatError` naming ``where``: not JSON
+    (line and column), or nested deeper than any file this reads (Python's parser recurses)."""
+    import json
+    from .errors import FileFormatError
+    try:
+        return json.loads(text)
+    except json.JSONDecodeError as error:
+        raise FileFormatError(f"{where}: not valid JSON ({error.msg} at line {error.lineno}, "
+                              f"column {error.colno})") from None
+    except RecursionError:
+        raise FileFormatError(f"{where}: JSON nested too deep to be a targets, tour or plan "
+                              "file") from None
+
+
+def read_json(path: str | os.PathLike):
+    """The JSON document in the file (:func:`read_text`, :func:`parse_json`)."""
+    return parse_json(read_text(path), str(path))
+
+
 def check_replaceable(path: str | os.PathLike) -> None:
     """:class:`FileAccessError` unless ``path`` is absent or a regular file (an output never
     replaces a device, a FIFO, a socket or a folder)."""

@@ -192,6 +192,12 @@ def _checked(request: PlanRequest) -> tuple[Targets, GeoTargets | None, LocalFra
     if settings is not None:
         settings.checked(request.rho_m)
         check_altitude_floor(geodetic, settings)
+        actions = geodetic.actions
+        if settings.loiter_radius_m is not None and (actions is None
+                                                     or not actions.loiter_turns.any()):
+            raise InputError("`loiter_radius_m` is the radius of the loiters at targets, and no "
+                             "target loiters: give `loiter_turns` TARGET[:TURNS] (or a "
+                             "loiter_turns column), or leave the radius out")
     return local, geodetic, frame
 
 

@@ -74,6 +74,35 @@ _ABOVE_HOME_FRAMES = {3, 6, 10, 11}
 
 
 _FLOAT32_MAX = 3.4028234663852886e38
+#: Frames whose altitude is above mean sea level (GLOBAL, GLOBAL_INT).
+_AMSL_FRAMES = {0, 5}
+#: No item of a mission is farther than this from its home: the flat mission frame ends about
+#: there (frame.MAX_SCALE_ERROR), and no small fixed wing flies a mission that wide.
+MAX_REACH_M = 150_000.0
+#: No item flies higher above home than this (targets.model.MAX_ALTITUDE_M).
+MAX_ALTITUDE_ABOVE_HOME_M = 10_000.0
+#: Commands that navigate without climbing away from the ground on purpose: a landing ends
+#: there.
+_DOWN_TO_GROUND = {int(Command.NAV_LAND), 85}     # NAV_LAND, NAV_VTOL_LAND
+
+
+def known_commands() -> frozenset[int]:
+    """Every MAV_CMD the MAVLink dialects of ArduPilot and PX4 define (pymavlink's
+    ardupilotmega, which includes common): a command outside it no autopilot knows."""
+    from pymavlink.dialects.v20 import ardupilotmega
+    return frozenset(int(value) for value in ardupilotmega.enums["MAV_CMD"]
+                     if not ardupilotmega.enums["MAV_CMD"][value].name.endswith("ENUM_END"))
+
+
+def _reach_m(home: "Home", item: "MissionItem") -> float:
+    from pyproj import Geod
+    _, _, distance = Geod(ellps="WGS84").inv(home.longitude_deg, home.latitude_deg,
+                                             item.longitude_deg, item.latitude_deg)
+    return float(distance)
+
+
+def _is_nav(item: "MissionItem") -> bool:
+    return int(item.command) < 100          # MAV_CMD_NAV_LAST is 95
 
 
 @dataclass(frozen=True)
@@ -129,9 +158,57 @@ class VehicleMission:
                 found.append(f"item {number} (command {int(item.command)}) is at latitude "
                              f"{item.latitude_deg:g}, longitude {item.longitude_deg:g}: not a "
                              "position in degrees")
-            elif (int(item.frame) in _ABOVE_HOME_FRAMES and int(item.command) < 100
-                  and int(item.command) != Command.NAV_LAND
+            elif (int(item.frame) in _ABOVE_HOME_FRAMES and _is_nav(item)
+                  and int(item.command) not in _DOWN_TO_GROUND
                   and not (item.altitude_m >= 0)):       # NaN too
                 found.append(f"item {number} (command {int(item.command)}) is {item.altitude_m:g} m "
                              "above home: below the ground the aircraft took off from")
+            elif (int(item.frame) in _AMSL_FRAMES and _is_nav(item)
+                  and int(item.command) not in _DOWN_TO_GROUND
+                  and not (item.altitude_m >= self.home.altitude_amsl_m)):
+                found.append(f"item {number} (command {int(item.command)}) is at "
+                             f"{item.altitude_m:g} m above mean sea level, "
+                             f"{self.home.altitude_amsl_m - item.altitude_m:g} m below home "
+                             f"({self.home.altitude_amsl_m:g} m): below the ground the aircraft "
+                             "took off from")
+            elif _reach_m(self.home, item) > MAX_REACH_M:
+                found.append(f"item {number} (command {int(item.command)}) at "
+                             f"({item.latitude_deg:.6f}, {item.longitude_deg:.6f}) is "
+                             f"{_reach_m(self.home, item) / 1000:,.0f} km from home: not part of a "
+                             f"mission flown from there (at most {MAX_REACH_M / 1000:.0f} km)")
+            if _is_nav(item) and self.height_above_home_m(item) > MAX_ALTITUDE_ABOVE_HOME_M:
+                found.append(f"item {number} (command {int(item.command)}) is "
+                             f"{self.height_above_home_m(item):,.0f} m above home: beyond the "
+                             f"{MAX_ALTITUDE_ABOVE_HOME_M:,.0f} m a mission is planned to")
+        known = known_commands()
+        for number, item in enumerate(self.items, start=1):
+            if int(item.command) not in known:
+                found.append(f"item {number}: command {int(item.command)} is no MAVLink command "
+                             "an autopilot knows (MAV_CMD); the vehicle would refuse it midway")
+            elif (int(item.command) == Command.NAV_LOITER_TURNS and int(self.autopilot)
+                  == Autopilot.ARDUPILOTMEGA and not 0 < item.params[0] <= 255):
+                found.append(f"item {number} (NAV_LOITER_TURNS): {item.params[0]:g} turns; "
+                             "ArduPilot keeps from 1 to 255 turns")
         return found
+
+    def height_above_home_m(self, item: MissionItem) -> float:
+        """The item's altitude above home (above the terrain for terrain frames; NaN for an
+        item without a position)."""
+        if int(item.frame) in _POSITIONLESS_FRAMES:
+            return float("nan")
+        if int(item.frame) in _AMSL_FRAMES:
+            return item.altitude_m - self.home.altitude_amsl_m
+        return item.altitude_m
+
+    def below_floor(self, min_altitude_m: float) -> list[str]:
+        """The navigation items (take-off, waypoints, loiters; not a landing) that fly lower
+        above home than ``min_altitude_m``, as ``plan --min-alt`` would refuse them."""
+        low = []
+        for number, item in enumerate(self.items, start=1):
+            if (_is_nav(item) and int(item.frame) not in _POSITIONLESS_FRAMES
+                    and int(item.command) not in _DOWN_TO_GROUND
+                    and int(item.command) != Command.NAV_RETURN_TO_LAUNCH
+                    and self.height_above_home_m(item) < min_altitude_m - 1e-6):
+                low.append(f"item {number} (command {int(item.command)}) at "
+                           f"{self.height_above_home_m(item):g} m above home")
+        return low

@@ -86,7 +86,7 @@ def check_parameters(values: dict[str, float], where: str = "parameters") -> Non
             if name == "WP_LOITER_RAD" and abs(value) < 1.0:
                 raise FileFormatError(f"{where}: WP_LOITER_RAD must be at least 1 m either way, "
                                       f"got {value:g}")
-        else:
+        elif name not in NAMES:
             close = difflib.get_close_matches(name, NAMES, n=1, cutoff=0.9)
             if close:
                 raise FileFormatError(f"{where}: {name} is not an ArduPlane parameter; did you "
@@ -102,22 +102,72 @@ def parameter_name(param_id: str | bytes) -> str:
 def parse_parameters(text: str, where: str = "parameters") -> dict[str, float]:
     """Every ``NAME VALUE`` of a parameter file's text, by name: ArduPilot's and MAVProxy's
     ``.parm`` lines, or QGroundControl's saved ``.params`` lines (``VEHICLE COMPONENT NAME
-    VALUE TYPE``, tab-separated)."""
+    VALUE TYPE``, tab-separated).  A byte-order mark is skipped; :class:`FileFormatError` for
+    a name given twice with two values (which one the vehicle has is anyone's guess) and for
+    a ``.params`` file that holds more than one vehicle's parameters."""
     values: dict[str, float] = {}
-    for number, line in enumerate(text.splitlines(), 1):
+    lines: dict[str, int] = {}
+    vehicles: set[str] = set()
+    for number, line in enumerate(text.lstrip("\ufeff").splitlines(), 1):
         line = line.split("#", 1)[0].strip()
         if not line:
             continue
         parts = line.replace(",", " ").split()
         if len(parts) >= 4 and parts[0].isdigit() and parts[1].isdigit():
+            vehicles.add(parts[0])
             parts = parts[2:4]                  # QGroundControl: vehicle, component, name, value
         if len(parts) < 2:
             raise FileFormatError(f"{where}, line {number}: expected NAME VALUE, got {line!r}")
+        name = parts[0].upper()
         try:
-            values[parts[0].upper()] = float(parts[1])
+            value = float(parts[1])
         except ValueError:
             raise FileFormatError(f"{where}, line {number}: {parts[1]!r} is not a number") from None
+        if name in values and not (value == values[name] or (math.isnan(value)
+                                                              and math.isnan(values[name]))):
+            raise FileFormatError(f"{where}: {name} is given twice, {values[name]:g} (line "
+                                  f"{lines[name]}) and {value:g} (line {number}); keep the "
+                                  "vehicle's one value")
+        values[name], lines[name] = value, number
+    if len(vehicles) > 1:
+        raise FileFormatError(f"{where}: holds the parameters of {len(vehicles)} vehicles (ids "
+                              f"{', '.join(sorted(vehicles, key=int))}); save one vehicle's")
     return values
+
+
+#: ArduPlane's names before 4.5 for parameters it has renamed: (new name, factor to its unit).
+ARDUPLANE_OLD_NAMES = {"TRIM_ARSPD_CM": ("AIRSPEED_CRUISE", 0.01),
+                       "LIM_ROLL_CD": ("ROLL_LIMIT_DEG", 0.01)}
+
+
+def with_current_names(values: dict[str, float], where: str = "parameters") -> dict[str, float]:
+    """``values`` with ArduPlane's pre-4.5 names (``TRIM_ARSPD_CM``, ``LIM_ROLL_CD``) read as
+    today's (``AIRSPEED_CRUISE``, ``ROLL_LIMIT_DEG``, in their units); :class:`FileFormatError`
+    when a file gives both names different values."""
+    values = dict(values)
+    for old, (new, factor) in ARDUPLANE_OLD_NAMES.items():
+        if old not in values:
+            continue
+        converted = values.pop(old) * factor
+        if new in values and not math.isclose(values[new], converted, rel_tol=1e-6):
+            raise FileFormatError(f"{where}: {old} {converted / factor:g} (the name before "
+                                  f"ArduPlane 4.5) and {new} {values[new]:g} disagree")
+        values[new] = converted
+    return values
+
+
+def check_autopilot_names(values: dict[str, float], autopilot: str, where: str) -> None:
+    """:class:`FileFormatError` when a parameter file for ``autopilot`` ("ardupilot" or
+    "px4") holds the other autopilot's navigation parameters: they would be ignored, and the
+    mission designed for a stock aircraft."""
+    foreign, theirs, ours = ((PX4_NAMES, "PX4", "ardupilot") if autopilot != "px4"
+                             else (NAMES + tuple(ARDUPLANE_OLD_NAMES), "ArduPlane", "px4"))
+    found = [name for name in values if name in foreign]
+    if found:
+        other = "px4" if ours == "ardupilot" else "ardupilot"
+        raise FileFormatError(f"{where}: holds {theirs} parameters ({', '.join(found[:3])}), "
+                              f"but the mission is for {'PX4' if ours == 'px4' else 'ArduPilot'}: "
+                              f"give that vehicle's parameters, or plan with `autopilot` {other}")
 
 
 def parameters_from(values: dict[str, float], base: VehicleParameters = ARDUPLANE_DEFAULTS) -> VehicleParameters:
@@ -131,7 +181,8 @@ def read_parameters(path: str | os.PathLike) -> VehicleParameters:
         text = Path(path).read_text(encoding="utf-8", errors="replace")
     except OSError as error:
         raise FileAccessError(f"cannot read the vehicle parameters {path}: {error.strerror}") from None
-    values = parse_parameters(text, str(path))
+    values = with_current_names(parse_parameters(text, str(path)), str(path))
+    check_autopilot_names(values, "ardupilot", str(path))
     check_parameters(values, str(path))
     return parameters_from(values)
 
@@ -173,6 +224,7 @@ def read_px4_parameters(path: str | os.PathLike) -> PX4Parameters:
     except OSError as error:
         raise FileAccessError(f"cannot read the vehicle parameters {path}: {error.strerror}") from None
     values = parse_parameters(text, str(path))
+    check_autopilot_names(values, "px4", str(path))
     check_px4_parameters(values, str(path))
     return PX4_DEFAULTS.with_values(values)
 

@@ -46,7 +46,8 @@ OPTIONS = {
     "tolerance_m": "--tolerance", "endurance_s": "--endurance", "return_mode": "--return",
     "airspeed_m_s": "--airspeed", "autopilot": "--autopilot", "origin": "--origin",
     "signing_key": "--signing-key", "via": "--via", "verify=False": "--no-verify",
-    "count": "--random", "format_name": "--format",
+    "count": "--random", "format_name": "--format", "design": "--design",
+    "landing_bearing_deg": "--landing-bearing", "launch_bearing_deg": "--launch-bearing",
 }
 
 

@@ -18,7 +18,15 @@ def _pose(text: str) -> np.ndarray:
         raise click.BadParameter(f"{text!r} is not X_M,Y_M,HEADING_DEG") from None
     if not all(map(math.isfinite, (x, y, heading_deg))):
         raise click.BadParameter(f"{text!r}: every number must be finite")
-    return np.array([x, y, math.radians(heading_deg)])
+    if max(abs(x), abs(y)) > MAX_COORDINATE_M:
+        raise click.BadParameter(f"{text!r}: x and y must be within +-{MAX_COORDINATE_M:,.0f} m "
+                                 "(a local frame in metres)")
+    return np.array([x, y, math.radians(math.fmod(heading_deg, 360.0))])   # fmod is exact
+
+
+#: Poses farther out than this are not in any local frame a mission is planned in (and their
+#: lengths would lose every digit below a metre).
+MAX_COORDINATE_M = 1e7
 
 
 @click.command(context_settings={"ignore_unknown_options": True})   # -5,0,0 is a pose

@@ -9,7 +9,7 @@ from ..autopilot.navigation import check_wind
 from ..sim.fly import check_targets_near, targets_from, targets_in
 from . import console
 from .console import console_options, note, say
-from .options import (UserError, airframe_from, apply, reports_errors, simulation_options,
+from .options import (LIMITS, UserError, airframe_from, apply, reports_errors, simulation_options,
                       vehicle_options)
 from .runs import run_flight_check
 
@@ -20,9 +20,9 @@ from .runs import run_flight_check
 @apply(simulation_options)
 @click.option("--via", default="pymavlink", show_default=True, help="Uploader to use.")
 @click.option("--format", "format_name", help="Format of MISSION_FILE, whatever its extension.")
-@click.option("--max-miss", "max_miss_m", type=float, metavar="METRES",
+@click.option("--max-miss", "max_miss_m", type=LIMITS["distance"], metavar="METRES",
               help="Exit with status 1 if any target is missed by more than this.")
-@click.option("--max-items", type=int, metavar="N", help="Mission slots of the simulated "
+@click.option("--max-items", type=LIMITS["max_items"], metavar="N", help="Mission slots of the simulated "
               "vehicle (default: a stock vehicle's, ArduPlane 655, PX4 500).")
 @click.option("--targets", "targets_file", type=click.Path(dir_okay=False), metavar="FILE",
               help="Measure the misses to these targets (the file the mission was planned "
@@ -64,7 +64,9 @@ def fly(mission_file, rho_m, airspeed_m_s, max_bank_deg, speedup, vehicle_params
     try:
         if targets_file is None:
             targets = targets_in(mission)
-            if not mission.targets:
+            if mission.targets:
+                check_targets_near(mission, targets, f"{mission_file}: the targets it carries")
+            else:
                 note("misses are measured to the target waypoints of the file (the guidance "
                      "design aims them off the targets): give --targets FILE to measure to the "
                      "targets")

@@ -5,6 +5,7 @@ from __future__ import annotations
 
 import functools
 import math
+from dataclasses import asdict, replace
 import sys
 import time
 from typing import Callable
@@ -46,10 +47,69 @@ class FiniteFloatRange(click.FloatRange):
         return number
 
 
+class Quantity(click.ParamType):
+    """A finite number of ``unit`` within ``[low, high]`` (``low_open``: above ``low``;
+    ``zero``: 0 also allowed, with its meaning), refused with the range and the unit.  Every
+    option that takes a quantity uses one of :data:`LIMITS`, so a flag has the same limits in
+    every command."""
+
+    def __init__(self, unit: str, low: float, high: float, low_open: bool = False,
+                 zero: str | None = None, integer: bool = False) -> None:
+        self.unit, self.low, self.high, self.low_open = unit, low, high, low_open
+        self.zero, self.integer = zero, integer
+        self.name = "integer" if integer else "number"
+
+    def describe(self) -> str:
+        shown = (lambda v: f"{v:,}") if self.integer else (lambda v: f"{v:g}")
+        low = f"above {shown(self.low)}" if self.low_open else f"from {shown(self.low)}"
+        text = f"{low} to {shown(self.high)}{' ' + self.unit if self.unit else ''}"
+        return f"0 ({self.zero}) or {text}" if self.zero else text
+
+    def convert(self, value, param, ctx):
+        if isinstance(value, (int, float)) and not isinstance(value, bool):
+            number = value
+        else:
+            text = str(value).strip()
+            try:
+                number = int(text) if self.integer else float(text)
+            except ValueError:
+                self.fail(f"{value!r} is not {'a whole number' if self.integer else 'a number'}"
+                          f" ({self.describe()})", param, ctx)
+        if self.zero and number == 0:
+            return number
+        inside = (math.isfinite(number)
+                  and (number > self.low if self.low_open else number >= self.low)
+                  and number <= self.high)
+        if not inside:
+            self.fail(f"{value} is out of range: {self.describe()}", param, ctx)
+        return number
+
+
+#: The limits of every quantity an option takes, shared by all commands (`plan`, `fly`,
+#: `sim`, `upload`, `dubins`, ...).  Where an autopilot parameter sets the same value, its
+#: range is checked as well once the aircraft is put together.
+LIMITS = {
+    "radius": Quantity("m", 0.1, 20_000.0),          # pipeline.MAX_PLAN_RADIUS_M
+    "airspeed": Quantity("m/s", 5.0, 100.0),          # ArduPlane's AIRSPEED_CRUISE range
+    "max_bank": Quantity("deg", 10.0, 89.0),          # ROLL_LIMIT_DEG (90: no finite radius)
+    "period": Quantity("s", 1.0, 100.0),              # NAVL1_PERIOD 1-60, NPFG_PERIOD 1-100
+    "speedup": Quantity("x real time", 0.1, 10_000.0, zero="as fast as possible"),
+    "distance": Quantity("m", 0.0, 10_000.0, low_open=True),
+    "altitude": Quantity("m", 0.0, 10_000.0, low_open=True),   # targets.model.MAX_ALTITUDE_M
+    "home_amsl": Quantity("m above mean sea level", -1_000.0, 9_000.0),
+    "bearing": Quantity("deg", -360.0, 360.0),
+    "wind_spread": Quantity("m/s", 0.0, 50.0),
+    "max_items": Quantity("mission items", 2, 65_535, integer=True),
+    "seconds": Quantity("s", 0.0, 86_400.0, low_open=True),
+    "seed": Quantity("", 0, 2**32 - 1, integer=True),
+    "count": Quantity("targets", 1, 1_000_000, integer=True),
+    "pitch": Quantity("deg", -90.0, 90.0),
+}
+
 radius_option = click.option(
-    "--radius", "rho_m", type=float, required=True, metavar="METRES",
+    "--radius", "rho_m", type=LIMITS["radius"], required=True, metavar="METRES",
     help="Minimum turn radius rho of the aircraft, in metres.")
-seed_option = click.option("--seed", type=click.IntRange(min=0), default=0, show_default=True,
+seed_option = click.option("--seed", type=LIMITS["seed"], default=0, show_default=True,
                            help="Seed of every random choice; the same seed gives the same result.")
 
 
@@ -100,31 +160,31 @@ WIND = WindType()
 
 #: The vehicle, defined once for every command that plans or flies.
 vehicle_options = [
-    click.option("--radius", "rho_m", type=float, metavar="METRES",
+    click.option("--radius", "rho_m", type=LIMITS["radius"], metavar="METRES",
                  help="Minimum turn radius rho of the aircraft, in metres (or give --airspeed "
                       "and --max-bank)."),
-    click.option("--airspeed", "airspeed_m_s", type=float, metavar="M/S",
+    click.option("--airspeed", "airspeed_m_s", type=LIMITS["airspeed"], metavar="M/S",
                  help="Cruise airspeed in m/s: sets the mission speed and the flight time; with "
                       "--max-bank it gives rho, the radius the aircraft turns at that bank."),
-    click.option("--max-bank", "max_bank_deg", type=float, metavar="DEG",
+    click.option("--max-bank", "max_bank_deg", type=LIMITS["max_bank"], metavar="DEG",
                  help="Largest bank angle in degrees, used with --airspeed to compute rho."),
 ]
 
 
 #: How a tour becomes a mission, defined once for every command that builds one.
 mission_options = [
-    click.option("--alt", "altitude_m", type=float, default=100.0, show_default=True,
+    click.option("--alt", "altitude_m", type=LIMITS["altitude"], default=100.0, show_default=True,
                  metavar="METRES", help="Cruise altitude above home (targets with an 'alt' use theirs)."),
-    click.option("--min-alt", "min_altitude_m", type=float, default=30.0, show_default=True,
+    click.option("--min-alt", "min_altitude_m", type=LIMITS["altitude"], default=30.0, show_default=True,
                  metavar="METRES", help="Altitude floor above home: no cruise or target altitude "
                  "below it (lower it only where the site is clear that low)."),
     click.option("--home", "home_deg", type=LAT_LON,
                  help="Launch and home position (default: the centre of the targets)."),
-    click.option("--home-amsl", "home_altitude_amsl_m", type=float, default=0.0, show_default=True,
+    click.option("--home-amsl", "home_altitude_amsl_m", type=LIMITS["home_amsl"], default=0.0, show_default=True,
                  metavar="METRES", help="Home altitude above mean sea level (for the .plan)."),
-    click.option("--launch-bearing", "launch_bearing_deg", type=float, metavar="DEG",
+    click.option("--launch-bearing", "launch_bearing_deg", type=LIMITS["bearing"], metavar="DEG",
                  help="Take-off direction, compass degrees (default: towards the first target)."),
-    click.option("--landing-bearing", "landing_bearing_deg", type=float, metavar="DEG",
+    click.option("--landing-bearing", "landing_bearing_deg", type=LIMITS["bearing"], metavar="DEG",
                  help="Landing direction, compass degrees (default: the launch bearing)."),
     click.option("--autopilot", type=click.Choice(["ardupilot", "px4"]), default="ardupilot",
                  show_default=True, help="Autopilot flavour of the mission."),
@@ -137,19 +197,19 @@ mission_options = [
                       "ArduPlane's navigation (the flight model, with --vehicle-params) passes "
                       "each within --max-miss, plus shaping waypoints where needed; or a "
                       "polyline within --tolerance of the exact path (PX4 always)."),
-    click.option("--max-miss", "max_miss_m", type=float, default=5.0, show_default=True,
+    click.option("--max-miss", "max_miss_m", type=LIMITS["distance"], default=5.0, show_default=True,
                  metavar="METRES", help="How close the predicted flight must pass each target "
                  "(the guidance design; with --simulate also the flight check's limit)."),
-    click.option("--wind-spread", "wind_spread_m_s", type=float, metavar="M/S",
+    click.option("--wind-spread", "wind_spread_m_s", type=LIMITS["wind_spread"], metavar="M/S",
                  help="How far the real wind may be from --wind: the guidance design also "
                       "holds every target within --max-miss in winds this much stronger and "
                       "weaker and turned 20 deg each way (default a quarter of the wind, at "
                       "least 1 m/s; 0: the forecast only)."),
-    click.option("--tolerance", "tolerance_m", type=float, metavar="METRES",
+    click.option("--tolerance", "tolerance_m", type=LIMITS["distance"], metavar="METRES",
                  help="--design geometry: largest distance between the exact path and the "
                       "waypoint polyline (default 2 % of rho; a quarter of it when the item "
                       "budget allows)."),
-    click.option("--max-items", type=int, metavar="N",
+    click.option("--max-items", type=LIMITS["max_items"], metavar="N",
                  help="Mission slots of the vehicle (default a stock vehicle's: 655 for "
                       "ArduPlane, home included; 500 for PX4; at most 65535)."),
 ]
@@ -212,14 +272,14 @@ link_options = [
     click.option("--signing-key", "signing_key_file", type=click.Path(dir_okay=False),
                  metavar="FILE", help="Sign with this MAVLink 2 key: 32 bytes, 64 hex digits, "
                                       "or a passphrase (its SHA-256)."),
-    click.option("--timeout", "transfer_timeout_s", type=float, metavar="S",
+    click.option("--timeout", "transfer_timeout_s", type=LIMITS["seconds"], metavar="S",
                  help="Give up a transfer (the upload, the verification download) after this "
                       "long.  Default: 30 s + 0.1 s per item."),
 ]
 
 #: The simulated aircraft's autopilot, defined once for `sim`, `fly` and `plan --simulate`.
 simulation_options = [
-    click.option("--speedup", type=float, default=50.0, show_default=True,
+    click.option("--speedup", type=LIMITS["speedup"], default=50.0, show_default=True,
                  help="Simulated seconds per wall-clock second (0: as fast as possible)."),
     click.option("--vehicle-params", "vehicle_params_file", type=click.Path(dir_okay=False),
                  metavar="FILE.parm", help="The vehicle's parameters (NAME VALUE lines, as "
@@ -227,7 +287,7 @@ simulation_options = [
                  "NAVL1_*, WP_RADIUS, ROLL_LIMIT_DEG, AIRSPEED_CRUISE, TECS_*; for a PX4 "
                  "mission its NPFG_PERIOD, NPFG_DAMPING, NPFG_SW_DST_MLT, NAV_ACC_RAD, FW_R_LIM, "
                  "FW_AIRSPD_TRIM, FW_T_*; default a stock vehicle's."),
-    click.option("--l1-period", "l1_period_s", type=float, metavar="S",
+    click.option("--l1-period", "l1_period_s", type=LIMITS["period"], metavar="S",
                  help="Override NAVL1_PERIOD, the L1 navigation period of the simulated "
                       "autopilot (NPFG_PERIOD for PX4)."),
     click.option("--wind", type=WIND, metavar="SPEED@FROM_DEG",
@@ -285,7 +345,8 @@ def airframe_from(vehicle_params_file, airspeed_m_s, max_bank_deg, l1_period_s,
         from ..autopilot.parameters import PX4_DEFAULTS
         px4 = designed_for(vehicle_params_file, autopilot) or (
             base if isinstance(base, type(PX4_DEFAULTS)) else PX4_DEFAULTS)
-        px4 = px4_parameters_with(px4, airspeed_m_s, max_bank_deg, l1_period_s, rho_m)
+        px4 = checked_aircraft(px4_parameters_with(px4, airspeed_m_s, max_bank_deg, l1_period_s,
+                                                   rho_m))
         airframe = Airframe.from_px4_parameters(px4)
         source = (f"PX4 navigation (NPFG): {origin}, trim airspeed {px4.FW_AIRSPD_TRIM:g} m/s "
                   f"({airframe.airspeed_m_s:.1f} m/s true, as PX4 SITL's fixed wing flies it), "
@@ -294,20 +355,42 @@ def airframe_from(vehicle_params_file, airspeed_m_s, max_bank_deg, l1_period_s,
         return airframe, px4, source
     parameters = designed_for(vehicle_params_file) or (
         base if isinstance(base, type(ARDUPLANE_DEFAULTS)) else ARDUPLANE_DEFAULTS)
-    parameters = parameters_with(parameters, airspeed_m_s, max_bank_deg, l1_period_s, rho_m)
+    parameters = checked_aircraft(parameters_with(parameters, airspeed_m_s, max_bank_deg,
+                                                  l1_period_s, rho_m))
     source = (f"ArduPlane navigation: {origin}, cruise {parameters.AIRSPEED_CRUISE:g} m/s, roll "
               f"limit {parameters.ROLL_LIMIT_DEG:.0f} deg, NAVL1_PERIOD "
               f"{parameters.NAVL1_PERIOD:g} s, WP_RADIUS {parameters.WP_RADIUS:g} m")
     return Airframe.from_parameters(parameters), parameters, source
 
 
-def designed_for(vehicle_params_file, autopilot="ardupilot"):
+def designed_for(vehicle_params_file, autopilot="ardupilot", l1_period_s=None):
     """The parameters a mission for ``autopilot`` is designed for: the file's (by ArduPlane's
-    or PX4's names), or None (a stock vehicle's)."""
-    if not vehicle_params_file:
+    or PX4's names) with ``--l1-period`` laid over them (NAVL1_PERIOD, PX4's NPFG_PERIOD), or
+    None (a stock vehicle's) when neither is given."""
+    if not vehicle_params_file and l1_period_s is None:
         return None
     from ..autopilot.commands import Autopilot
-    from ..autopilot.parameters import read_parameters, read_px4_parameters
-    if autopilot in ("px4", Autopilot.PX4):
-        return read_px4_parameters(vehicle_params_file)
-    return read_parameters(vehicle_params_file)
+    from ..autopilot.parameters import (ARDUPLANE_DEFAULTS, PX4_DEFAULTS, read_parameters,
+                                        read_px4_parameters)
+    px4 = autopilot in ("px4", Autopilot.PX4)
+    if px4:
+        parameters = read_px4_parameters(vehicle_params_file) if vehicle_params_file else PX4_DEFAULTS
+    else:
+        parameters = read_parameters(vehicle_params_file) if vehicle_params_file else ARDUPLANE_DEFAULTS
+    if l1_period_s is not None:
+        parameters = checked_aircraft(
+            replace(parameters, **{"NPFG_PERIOD" if px4 else "NAVL1_PERIOD": l1_period_s}))
+    return parameters
+
+
+def checked_aircraft(parameters):
+    """``parameters`` (ArduPlane's or PX4's) once options are laid over them, each value
+    checked against the autopilot's range (InputError naming the parameter and its option)."""
+    from ..autopilot.parameters import PX4Parameters, check_parameters, check_px4_parameters
+    values = asdict(parameters)
+    where = "the aircraft (--vehicle-params and the options laid over them)"
+    if isinstance(parameters, PX4Parameters):
+        check_px4_parameters(values, where)
+    else:
+        check_parameters(values, where)
+    return parameters

@@ -28,7 +28,7 @@ from ..targets.actions import TargetActions, check_loiter_turns
 from ..targets.geojson_file import read_geojson
 from . import console
 from .console import console_options, note, record, say
-from .options import (FiniteFloatRange, LAT_LON, UserError, airframe_from, apply,
+from .options import (FiniteFloatRange, LAT_LON, LIMITS, UserError, airframe_from, apply,
                       designed_for as designed_for_file, link_options, mission_options,
                       mission_settings, progress_reporter, reports_errors, seed_option,
                       simulation_options, turn_radius_from, vehicle_options)
@@ -94,7 +94,7 @@ def _duration(seconds: float) -> str:
 
 @click.command()
 @click.argument("targets_file", required=False, type=click.Path(dir_okay=False))
-@click.option("--random", "random_count", type=int, metavar="N",
+@click.option("--random", "random_count", type=LIMITS["count"], metavar="N",
               help="Plan through N seeded uniform random targets inside the --area polygon.")
 @click.option("--area", "area_file", type=click.Path(dir_okay=False), metavar="AREA.geojson",
               help="Survey area (a GeoJSON Polygon): for --random, the lower bound and the plot.")
@@ -136,14 +136,14 @@ def _duration(seconds: float) -> str:
 @click.option("--roi", is_flag=True, help="Point the camera at each target from the previous one "
               "on (DO_SET_ROI / DO_SET_ROI_LOCATION), off after the last; a 'roi' column chooses "
               "targets.")
-@click.option("--gimbal-pitch", "gimbal_pitch_deg", type=float, metavar="DEG",
+@click.option("--gimbal-pitch", "gimbal_pitch_deg", type=LIMITS["pitch"], metavar="DEG",
               help="Gimbal pitch for targets without a 'gimbal_pitch' of their own (-90 looks "
                    "straight down; DO_MOUNT_CONTROL / DO_GIMBAL_MANAGER_PITCHYAW).")
 @click.option("--loiter", "loiter_specs", multiple=True, metavar="TARGET[:TURNS]",
               help="Circle this target (a name from the file or a 1-based number) TURNS whole "
                    "times (default 1) before going on: circles through the target, tangent to "
                    "the tour. Repeatable; a 'loiter_turns' column does the same.")
-@click.option("--loiter-radius", "loiter_radius_m", type=float, metavar="METRES",
+@click.option("--loiter-radius", "loiter_radius_m", type=LIMITS["distance"], metavar="METRES",
               help="Radius of the loiter circles (default 1.3 x the turn radius).")
 @click.option("--simulate", is_flag=True, help="Fly the mission in the simulator (an ArduPlane "
               "with --vehicle-params, stock without) and print per-target miss distances.")
@@ -174,7 +174,7 @@ def plan(targets_file, random_count, area_file, seed, origin, rho_m, airspeed_m_
     _check_writable([*outputs, *([plot_file] if plot_file else [])])
     if algorithm in ("rbta", "auto") and region not in ("bounding", "min-area"):
         region_heading_deg(region)
-    designed_for = designed_for_file(vehicle_params_file, autopilot)
+    designed_for = designed_for_file(vehicle_params_file, autopilot, l1_period_s)
     rho, rho_source = turn_radius_from(rho_m, airspeed_m_s, max_bank_deg,
                                        designed_for if autopilot == "ardupilot" else None)
     targets = _targets(targets_file, random_count, area_file, seed, rho)

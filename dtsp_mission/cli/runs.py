@@ -8,7 +8,8 @@ import click
 import numpy as np
 
 from ..autopilot.navigation import CALM
-from ..sim.fly import FlightCheck, estimated_flight_m, fly_mission
+from ..sim.fly import (FlightCheck, check_flyable, estimated_flight_m, estimated_flight_s,
+                       fly_mission)
 from ..upload import to_wire, upload_mission
 from ..upload.connection import read_signing_key
 from .console import note, record, say
@@ -57,7 +58,9 @@ def run_flight_check(mission, targets, airframe, via: str, speedup: float,
                      max_miss_m: float | None, max_items: int | None = None,
                      wind=None) -> FlightCheck:
     """Fly, print the report, and fail (exit 1) when ``max_miss_m`` is exceeded (shared with
-    ``plan --simulate``)."""
+    ``plan --simulate``).  A mission the simulator cannot fly as the autopilot would
+    (:func:`~dtsp_mission.sim.fly.check_flyable`) is refused before anything flies."""
+    check_flyable(mission, airframe)
     _say_estimate(mission, airframe, speedup)
     progress, close = progress_reporter("flying")
     try:
@@ -82,7 +85,7 @@ def run_flight_check(mission, targets, airframe, via: str, speedup: float,
 def _say_estimate(mission, airframe, speedup: float) -> None:
     """Say up front how long the flight will take (flight time, and the wait at ``speedup``)."""
     length = estimated_flight_m(mission, airframe.loiter_radius_m)
-    flight_s = length / airframe.airspeed_m_s
+    flight_s = estimated_flight_s(mission, airframe)
     wait = (f"about {_duration(flight_s / speedup)} to simulate at --speedup {speedup:g}"
             if speedup > 0 else "simulated as fast as it computes")
     say(f"flying about {length / 1000:,.1f} km, {_duration(flight_s)} of flight; {wait}")

@@ -11,7 +11,7 @@ from ..mission import AUTOPILOTS
 from ..mission.model import Home
 from ..sim.vehicle import SimulatedVehicle, VehicleSettings
 from ..upload.connection import read_signing_key
-from .options import (LAT_LON, UserError, airframe_from, apply, reports_errors,
+from .options import (LAT_LON, LIMITS, UserError, airframe_from, apply, reports_errors,
                       simulation_options, vehicle_options)
 
 
@@ -26,14 +26,14 @@ from .options import (LAT_LON, UserError, airframe_from, apply, reports_errors,
 @click.option("--gcs", metavar="HOST:PORT", help="Also send to a ground station listening here "
               "(QGroundControl listens on 127.0.0.1:14550) before it speaks.")
 @click.option("--home", "home_deg", type=LAT_LON, required=True, help="Where the vehicle stands.")
-@click.option("--home-amsl", "home_amsl_m", type=float, default=0.0, show_default=True,
+@click.option("--home-amsl", "home_amsl_m", type=LIMITS["home_amsl"], default=0.0, show_default=True,
               metavar="METRES")
 @click.option("--autopilot", type=click.Choice(sorted(AUTOPILOTS)), default="ardupilot",
               show_default=True, help="Autopilot the vehicle claims to be (ArduPilot keeps home "
                                       "at seq 0).")
 @apply(vehicle_options)
 @apply(simulation_options)
-@click.option("--max-items", type=int, metavar="N",
+@click.option("--max-items", type=LIMITS["max_items"], metavar="N",
               help="Mission slots (home included on ArduPilot); a longer upload gets "
                    "MAV_MISSION_NO_SPACE.  Default: a stock vehicle's (ArduPlane 655, PX4 500).")
 @click.option("--signing-key", "signing_key_file", type=click.Path(dir_okay=False),

@@ -6,7 +6,7 @@ import click
 
 from . import console
 from .console import console_options, say
-from .options import (UserError, apply, designed_for, link_options, mission_options,
+from .options import (LIMITS, UserError, apply, designed_for, link_options, mission_options,
                       mission_settings, reports_errors, vehicle_options)
 from .runs import run_upload
 
@@ -18,7 +18,7 @@ from .runs import run_upload
                    "device like /dev/ttyACM0,57600.")
 @apply(link_options)
 @click.option("--format", "format_name", help="Format of MISSION_FILE, whatever its extension.")
-@click.option("--heartbeat-timeout", "heartbeat_timeout_s", type=float, default=5.0,
+@click.option("--heartbeat-timeout", "heartbeat_timeout_s", type=LIMITS["seconds"], default=5.0,
               show_default=True, metavar="S", help="How long to wait for the vehicle.")
 @apply(mission_options)
 @vehicle_options[1]        # --airspeed, for the tour's mission
@@ -56,6 +56,12 @@ def upload(mission_file, connection, via, verify, signing_key_file, transfer_tim
         mission = _tour_mission(mission_file, mission_settings(**mission_option_values))
     else:
         mission = read_mission(mission_file, format_name)
+        floor = mission_option_values["min_altitude_m"]
+        low = mission.below_floor(floor)
+        if low:
+            raise UserError(f"{mission_file}: {len(low)} navigation item(s) below the altitude "
+                            f"floor of {floor:g} m above home (--min-alt): {'; '.join(low[:3])}; "
+                            "nothing was sent (if the site is clear that low, lower --min-alt)")
     run_upload(mission, connection, via, verify, signing_key_file, heartbeat_timeout_s,
                designed_for(vehicle_params_file, mission.autopilot), transfer_timeout_s)
     console.finish()
@@ -63,16 +69,14 @@ def upload(mission_file, connection, via, verify, signing_key_file, transfer_tim
 
 def _tour_mission(path, settings):
     """The mission of a tour file placed on the earth by its frame origin."""
-    import json
-
-    from ..files import read_text
+    from ..files import read_json
     from ..frame import LocalFrame
     from ..mission import build_mission
     from ..targets.model import local_targets
     from ..tour import read_tour
     from ..tour.json_form import origin_from_dict
     tour = read_tour(path)
-    origin = origin_from_dict(json.loads(read_text(path)))
+    origin = origin_from_dict(read_json(path))
     if origin is None:
         raise UserError(f"{path}: the tour has no frame origin, so it cannot be placed on the "
                         "earth; plan from lat/lon targets (or with --origin) and write the .json again")

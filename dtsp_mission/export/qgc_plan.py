@@ -15,7 +15,7 @@ import math
 from typing import Any
 
 from ..errors import FileFormatError, TourInvalidError
-from ..files import read_text
+from ..files import read_json
 from ..mission import Autopilot, Home, Mission, MissionItem, VehicleMission
 from ..autopilot.mission import MissionTarget
 from ..autopilot.parameters import checked_parameters
@@ -196,10 +196,14 @@ def _item_violations(item: Any) -> list[str]:
             problems.append("params 1-4 must be numbers or null")
         if not all(_is_number(p) for p in params[4:]):
             problems.append("params 5-7 (lat, lon, alt) must be numbers")
+    # QGroundControl writes all three on every item it saves, AMSLAltAboveTerrain null unless
+    # the altitude mode is terrain-following (it is the AMSL altitude computed for that mode).
     altitude_keys = [key in item for key in ("AltitudeMode", "Altitude", "AMSLAltAboveTerrain")]
-    if any(altitude_keys) and not (all(altitude_keys) and all(
-            _is_number(item[k]) for k in ("AltitudeMode", "Altitude", "AMSLAltAboveTerrain"))):
-        problems.append("AltitudeMode, Altitude and AMSLAltAboveTerrain go together, as numbers")
+    if any(altitude_keys) and not (
+            all(altitude_keys) and _is_integer(item["AltitudeMode"]) and _is_number(item["Altitude"])
+            and (item["AMSLAltAboveTerrain"] is None or _is_number(item["AMSLAltAboveTerrain"]))):
+        problems.append("AltitudeMode, Altitude and AMSLAltAboveTerrain go together (an integer, "
+                        "a number, and a number or null)")
     return problems
 
 
@@ -236,10 +240,7 @@ class QGCPlanExporter(Exporter):
     readable = True
 
     def read(self, path) -> VehicleMission:
-        try:
-            data = json.loads(read_text(path))
-        except json.JSONDecodeError as error:
-            raise FileFormatError(f"{path}: not JSON ({error.msg} at line {error.lineno})") from None
+        data = read_json(path)
         problems = plan_rule_violations(data)
         if problems:
             raise FileFormatError(f"{path}: not a valid QGroundControl plan: " + "; ".join(problems[:3]))

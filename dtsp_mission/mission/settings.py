@@ -148,7 +148,16 @@ class MissionSettings:
         if not (math.isfinite(spread) and 0 <= spread <= MAX_WIND_M_S):
             raise InputError(f"the wind spread (`wind_spread_m_s`) must be from 0 to "
                              f"{MAX_WIND_M_S:g} m/s, got {spread!r}")
-        check_wind(Wind(self.wind.speed_m_s + spread, self.wind.from_deg), airspeed)
+        strongest = self.wind.speed_m_s + spread
+        if strongest > 0.7 * airspeed:
+            given = (f"the wind given ({self.wind.speed_m_s:g} m/s) plus " if self.wind.speed_m_s
+                     else "in calm air, ")
+            raise InputError(
+                f"the guidance design also flies {given}its spread of {spread:g} m/s "
+                f"(`wind_spread_m_s`{', by default a quarter of the wind and at least 1 m/s' if self.wind_spread_m_s is None else ''}): "
+                f"{strongest:g} m/s is more than 70 % of the airspeed ({airspeed:g} m/s); "
+                f"give a smaller `wind_spread_m_s` (at most "
+                f"{max(0.0, 0.7 * airspeed - self.wind.speed_m_s):.1f} m/s) or a faster `airspeed_m_s`")
         if self.autopilot == "ardupilot" and (self.vehicle is not None or self.design == "guidance"
                                               or self.airspeed_m_s is not None):
             check_turn_radius(rho_m, self.vehicle or ARDUPLANE_DEFAULTS, self.airspeed_m_s)
@@ -161,8 +170,18 @@ class MissionSettings:
             if value is not None and not math.isfinite(value):
                 raise InputError(f"{name.replace('_deg', '').replace('_', ' ')} must be a number "
                                  "of degrees")
+        if self.landing_bearing_deg is not None and return_mode != "land":
+            raise InputError(f"a landing bearing is for `return_mode` land; with {return_mode} "
+                             "the mission has no landing of its own (RTL lands as the autopilot's "
+                             "RTL does): leave it out or return with land")
+        if self.tolerance_m is not None and self.design == "guidance":
+            raise InputError("the waypoint tolerance (`tolerance_m`) is for `design` geometry; the "
+                             "guidance design places its waypoints by the predicted flight, held "
+                             "within `max_miss_m`: leave it out or design the geometry")
+        bearings = {name: getattr(self, name) % 360.0 for name in
+                    ("launch_bearing_deg", "landing_bearing_deg") if getattr(self, name) is not None}
         return replace(self, return_mode=return_mode, tolerance_m=tolerance, max_items=max_items,
-                       wind_spread_m_s=spread, model_margin_m=margin)
+                       wind_spread_m_s=spread, model_margin_m=margin, **bearings)
 
     def design_airframe(self) -> Airframe:
         """The aircraft the guidance design flies: the autopilot's navigation with the

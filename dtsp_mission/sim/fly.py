@@ -94,6 +94,53 @@ def estimated_flight_m(mission: VehicleMission, loiter_radius_m: float) -> float
     return length
 
 
+#: The longest flight the simulator flies (s of simulated flight): a day.
+MAX_SIMULATED_FLIGHT_S = 24 * 3600.0
+#: Items an autopilot flies that the flight model does not, and why no flight of them is
+#: "complete" in the simulator.
+NOT_FLOWN = {
+    int(Command.NAV_LOITER_UNLIM): "loiters until told otherwise: the flight never ends by itself",
+    93: "waits (NAV_DELAY) before going on, which the flight model does not fly",
+    177: "jumps back (DO_JUMP), which the flight model does not fly",
+}
+
+
+def estimated_flight_s(mission: VehicleMission, airframe: Airframe) -> float:
+    """A quick estimate of the flight's duration (:func:`estimated_flight_m` at the airspeed,
+    and the time NAV_LOITER_TIME items hold)."""
+    held = sum(max(0.0, float(item.params[0])) for item in mission.items
+               if item.command == Command.NAV_LOITER_TIME)
+    return estimated_flight_m(mission, airframe.loiter_radius_m) / airframe.airspeed_m_s + held
+
+
+def check_flyable(mission: VehicleMission, airframe: Airframe) -> None:
+    """:class:`InputError` for a mission the simulator cannot fly as the autopilot would --
+    an item it does not model (DO_JUMP, NAV_LOITER_UNLIM, NAV_DELAY, another navigation
+    command), or a flight longer than :data:`MAX_SIMULATED_FLIGHT_S` -- so that no such
+    flight is reported complete (or waited for for ever)."""
+    from ..autopilot.navigation import NAV_COMMANDS
+    for number, item in enumerate(mission.items, start=1):
+        command = int(item.command)
+        reason = NOT_FLOWN.get(command)
+        if reason is None and command < 100 and command not in {int(c) for c in NAV_COMMANDS}:
+            reason = "is a navigation command the flight model does not fly"
+        if reason is not None:
+            extra = ""
+            if command == 177:
+                extra = (f" (to item {item.params[0]:g}, "
+                         + ("for ever" if item.params[1] < 0 else f"{item.params[1]:g} times")
+                         + ")")
+            raise InputError(f"item {number} (command {command}){extra} {reason}; the simulator "
+                             "would report a flight the vehicle does not make, so it does not "
+                             "fly this mission")
+    flight_s = estimated_flight_s(mission, airframe)
+    if not flight_s <= MAX_SIMULATED_FLIGHT_S:
+        raise InputError(f"the mission would fly for about {flight_s / 3600:,.0f} h (its legs and "
+                         "loiter times); the simulator flies at most "
+                         f"{MAX_SIMULATED_FLIGHT_S / 3600:.0f} h: check the loiter times and the "
+                         "positions")
+
+
 def check_targets_near(mission: VehicleMission, targets: Targets, where: str) -> None:
     """:class:`InputError` when a target is more than :data:`FAR_FROM_MISSION_M` from every
     position of the mission (its home and items): they are not this mission's targets."""
@@ -208,7 +255,7 @@ def _watch(vehicle: SimulatedVehicle, connection: str, mission: VehicleMission, 
         if ack is None or ack.result != 0:
             raise LinkError("the simulated vehicle did not start the mission")
         airframe = vehicle.settings.airframe
-        flight_s = estimated_flight_m(mission, airframe.loiter_radius_m) / airframe.airspeed_m_s
+        flight_s = estimated_flight_s(mission, airframe)
         # Twice the estimated flight (at least 4 h of it) at the speed-up, and time to start.
         budget = timeout_s or (60.0 + 2 * max(flight_s, 7200.0) / max(speedup, 1.0)
                                + len(mission.items))

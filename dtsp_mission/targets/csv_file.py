@@ -114,16 +114,24 @@ def read_csv(path: str | os.PathLike, text: str | None = None) -> GeoTargets | T
     delimiter = _delimiter(content[0])
     # comment lines are blanked, not dropped, so that the reader's line count is the file's
     reader = csv.reader(("\n" if line.lstrip().startswith("#") else line for line in lines),
-                        delimiter=delimiter)
+                        delimiter=delimiter, strict=True)
     rows, line_of = [], []
     last = 0
     try:
         for row in reader:
             first_line, last = last + 1, reader.line_num
+            if last > first_line:
+                # a quoted field ran over a line end: a quote left open swallows the rows after it
+                raise FileFormatError(f"{path}, line {first_line}: a quoted field runs on to line "
+                                      f"{last}, taking the lines between into one cell (a quote "
+                                      "left open?); targets need one line each")
             if any(cell.strip() for cell in row):
                 rows.append(row)
                 line_of.append(first_line)
     except csv.Error as error:
+        if "end of data" in str(error):
+            raise FileFormatError(f"{path}, line {last + 1}: a quote opened here is never closed "
+                                  "(it would take every line after it into one cell)") from None
         raise FileFormatError(f"{path}, line {reader.line_num}: {error}") from None
     columns, unused = _header(path, rows[0], line_of[0])
     geodetic = "lat" in columns

@@ -21,7 +21,7 @@ from shapely.geometry import shape
 from shapely.validation import explain_validity
 
 from ..errors import FileFormatError
-from ..files import read_text
+from ..files import parse_json, read_text
 from ..frame import check_geodetic
 from ..errors import InputError
 from .actions import COLUMNS, actions_from_columns, column_key, parse_cell
@@ -46,6 +46,30 @@ def _features(data: Any, path) -> list[dict]:
     return [{"type": "Feature", "geometry": data, "properties": {}}]
 
 
+#: The names of RFC 7946's one coordinate reference system (WGS 84, longitude then latitude),
+#: as older GeoJSON (2008) and GDAL write it in a ``crs`` member.
+CRS84 = {"urn:ogc:def:crs:OGC:1.3:CRS84", "urn:ogc:def:crs:OGC::CRS84", "OGC:CRS84",
+         "http://www.opengis.net/def/crs/OGC/1.3/CRS84"}
+
+
+def check_crs(data: Any, path) -> None:
+    """:class:`FileFormatError` for a ``crs`` member naming anything but CRS84: RFC 7946
+    GeoJSON is [longitude, latitude] on WGS 84, and a file declaring another system (EPSG:4326
+    is latitude first; a projected system is metres) would be read at the wrong place."""
+    if not isinstance(data, dict) or "crs" not in data or data["crs"] is None:
+        return
+    crs = data["crs"]
+    name = crs.get("properties", {}).get("name") if isinstance(crs, dict) and isinstance(
+        crs.get("properties"), dict) else None
+    if isinstance(name, str) and name.strip() in CRS84:
+        return
+    raise FileFormatError(
+        f"{path}: declares the coordinate system {name or crs!r}; GeoJSON targets are read as "
+        "RFC 7946 (WGS 84 [longitude, latitude], no 'crs'), and another system's coordinates "
+        "(EPSG:4326 puts latitude first) would be planned at the wrong place: write RFC 7946 "
+        "GeoJSON (e.g. ogr2ogr -f GeoJSON -lco RFC7946=YES out.geojson in.geojson)")
+
+
 def area_from_geometry(geometry: dict, where: str) -> np.ndarray:
     """The outer ring of a GeoJSON Polygon as (k, 2) rows of (latitude, longitude), checked to be
     a valid (non self-intersecting, non-empty) polygon."""
@@ -58,6 +82,11 @@ def area_from_geometry(geometry: dict, where: str) -> np.ndarray:
                               f"({explain_validity(polygon)})")
     if polygon.is_empty or polygon.area <= 0.0:
         raise FileFormatError(f"{where}: the survey polygon is empty")
+    if len(polygon.interiors):
+        raise FileFormatError(f"{where}: the survey polygon has {len(polygon.interiors)} "
+                              "hole(s); areas with holes are not supported (targets would be "
+                              "drawn and bounded inside them): give the outer ring only, or "
+                              "split the area into polygons without holes")
     ring = np.asarray(polygon.exterior.coords)[:, :2]
     check_geodetic(ring[:, 1], ring[:, 0], f"{where}: vertex")
     return ring[:, ::-1].copy()
@@ -67,10 +96,8 @@ def read_geojson(path: str | os.PathLike, text: str | None = None) -> GeoTargets
     """Targets (possibly none, if the file only holds a survey area) and the survey area;
     ``text``: the content, already read from ``path``."""
     text = read_text(path) if text is None else text
-    try:
-        data = json.loads(text)
-    except json.JSONDecodeError as error:
-        raise FileFormatError(f"{path}: not valid JSON ({error.msg} at line {error.lineno})") from None
+    data = parse_json(text, str(path))
+    check_crs(data, path)
     latitudes: list[float] = []
     longitudes: list[float] = []
     names: list[str] = []

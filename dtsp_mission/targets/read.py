@@ -20,9 +20,15 @@ def read_targets(path: str | os.PathLike) -> GeoTargets | Targets:
     if str(path) == STDIN:
         text = read_text(STDIN)
         reader = read_geojson if text.lstrip().startswith("{") else read_csv
-        return reader("standard input", text)
-    suffix = Path(path).suffix.lower()
-    if suffix not in READERS:
-        raise FileFormatError(f"{path}: cannot tell the format from {suffix or 'no extension'!r}; "
-                              "targets are read from .csv or .geojson files")
-    return READERS[suffix](path)
+        targets = reader("standard input", text)
+    else:
+        suffix = Path(path).suffix.lower()
+        if suffix not in READERS:
+            raise FileFormatError(f"{path}: cannot tell the format from {suffix or 'no extension'!r}; "
+                                  "targets are read from .csv or .geojson files")
+        targets = READERS[suffix](path)
+    if len(targets) == 0:
+        raise FileFormatError(f"{path}: no point targets, only a survey area (a Polygon): give "
+                              "Point features, or draw targets in the area with --random N "
+                              "--area " + str(path))
+    return targets

@@ -16,7 +16,7 @@ from typing import Any
 import numpy as np
 
 from ..errors import FileFormatError
-from ..files import read_text, write_atomic
+from ..files import read_json, read_text, write_atomic
 from ..segments import SegmentChain
 from .model import Tour
 
@@ -149,12 +149,7 @@ def origin_from_dict(data: dict[str, Any]) -> tuple[float, float] | None:
 
 def read_tour(path: str | os.PathLike) -> Tour:
     """Read a tour file; errors name the file and what is wrong in it."""
-    text = read_text(path)
-    try:
-        data = json.loads(text)
-    except json.JSONDecodeError as error:
-        raise FileFormatError(f"{path}: not valid JSON (line {error.lineno}, column "
-                              f"{error.colno}: {error.msg})") from None
+    data = read_json(path)
     try:
         return tour_from_dict(data)
     except FileFormatError as error:
