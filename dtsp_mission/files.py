@@ -91,13 +91,15 @@ def write_atomic(path: str | os.PathLike, content: str | bytes) -> Path:
 
 
 def write_together(outputs: Sequence[tuple[str | os.PathLike, str | bytes]],
-                   before_commit: Callable[[], None] | None = None) -> list[Path]:
+                   before_commit: Callable[[], None] | None = None,
+                   remove: Sequence[str | os.PathLike] = ()) -> list[Path]:
     """Write every output or none.
 
     Each content is written and flushed to a temporary file beside its target; only when all
     are written (and ``before_commit``, if given, has returned -- an upload, say) are they
-    renamed into place, one after the other.  If anything fails first, the temporary files are
-    removed and no target is touched.  A target that exists must be a regular file."""
+    renamed into place, one after the other, and then the files of ``remove`` (outputs of an
+    earlier run that these make stale) deleted.  If anything fails first, the temporary files
+    are removed and no target is touched.  A target that exists must be a regular file."""
     staged: list[tuple[Path, str]] = []
     try:
         for path, content in outputs:
@@ -110,6 +112,14 @@ def write_together(outputs: Sequence[tuple[str | os.PathLike, str | bytes]],
                 os.replace(temporary, path)
             except OSError as error:
                 raise FileAccessError(f"{path}: cannot be written ({error.strerror})") from None
+        for path in remove:
+            try:
+                os.unlink(path)
+            except FileNotFoundError:
+                pass
+            except OSError as error:
+                raise FileAccessError(f"{path}: a stale output of an earlier run cannot be "
+                                      f"removed ({error.strerror})") from None
     finally:
         for _, temporary in staged:
             try:

@@ -35,14 +35,20 @@ from .options import (FiniteFloatRange, LAT_LON, LIMITS, UserError, airframe_fro
 from .runs import run_flight_check, run_upload
 
 
-def _check_writable(paths) -> None:
+def _check_writable(paths, inputs=()) -> None:
     """UserError, before any work, for an output whose folder does not exist or is not
-    writable, or two outputs to the same file."""
+    writable, two outputs to the same file, or an output that is one of the ``inputs``."""
     seen = set()
+    read = {Path(path).resolve(): path for path in inputs if path and path != "-"}
     for path in paths:
         resolved = Path(path).resolve()
         if resolved in seen:
             raise UserError(f"{path} is given twice as an output")
+        if resolved in read or (resolved.exists() and any(
+                resolved.samefile(other) for other in read if other.exists())):
+            raise UserError(f"{path} is an input of this run ({read.get(resolved, path)}); "
+                            "writing it would replace what it was planned from: choose another "
+                            "output name")
         seen.add(resolved)
         try:
             check_replaceable(path)
@@ -171,7 +177,8 @@ def plan(targets_file, random_count, area_file, seed, origin, rho_m, airspeed_m_
     if plot_file:
         require_matplotlib()
         plot_format(plot_file)
-    _check_writable([*outputs, *([plot_file] if plot_file else [])])
+    inputs = (targets_file, area_file, vehicle_params_file, signing_key_file)
+    _check_writable([*outputs, *([plot_file] if plot_file else [])], inputs)
     if algorithm in ("rbta", "auto") and region not in ("bounding", "min-area"):
         region_heading_deg(region)
     designed_for = designed_for_file(vehicle_params_file, autopilot, l1_period_s)
@@ -249,6 +256,10 @@ def plan(targets_file, random_count, area_file, seed, origin, rho_m, airspeed_m_
                          for k, sortie in enumerate(sorties)]
         else:
             rendered.append((output, writer.description, writer.render_for(product, output, frame)))
+    if sorties:
+        _check_writable([path for path, _, _ in rendered], inputs)
+    stale = _stale_sorties([(output, writer) for output, writer in writers if writer.needs_mission],
+                           {str(path): content for path, _, content in rendered})
     if plot_file:
         rendered.append((plot_file, "plot", render_plan(product, plot_format(plot_file),
                                                          result.area_m)))
@@ -258,9 +269,12 @@ def plan(targets_file, random_count, area_file, seed, origin, rho_m, airspeed_m_
         def upload() -> None:
             run_upload(product.for_vehicle(), connection, via, verify, signing_key_file,
                        designed_for=designed_for, transfer_timeout_s=transfer_timeout_s)
-    write_together([(output, content) for output, _, content in rendered], before_commit=upload)
+    write_together([(output, content) for output, _, content in rendered], before_commit=upload,
+                   remove=stale)
     for output, description, _ in rendered:
         say(f"wrote {output} ({description})")
+    for path in stale:
+        say(f"removed {path} (written by an earlier run for this output, no longer current)")
         if description == "plot":
             record(plot=str(output))
         else:
@@ -276,6 +290,54 @@ def plan(targets_file, random_count, area_file, seed, origin, rho_m, airspeed_m_
                              speedup, max_miss_m, max_items, wind)
             console.current().summary.setdefault("simulated", []).append(console.current().summary.pop("flight"))
     console.finish()
+
+
+def _sortie_family(output: str) -> list[Path]:
+    """The files that are, by their names, sorties of ``output`` (``mission-<k>.plan``
+    beside ``mission.plan``), and ``output`` itself, as they exist now."""
+    import re
+    base = Path(sortie_path(output, 0))
+    pattern = re.compile(re.escape(base.name).replace("\\-0", "-([1-9][0-9]*)", 1) + "$")
+    family = [path for path in base.parent.glob("*") if pattern.match(path.name)]
+    return family + ([Path(output)] if Path(output).exists() else [])
+
+
+def _written_by_us(path: Path, fresh: str | bytes | None) -> bool:
+    """Whether ``path`` is a mission file dtsp-mission wrote (its marks: a .plan's
+    groundStation, a GeoJSON's generator, a tour's format; a .waypoints, which has no room for
+    a mark, when its home line is the one written now)."""
+    try:
+        with open(path, "rb") as stream:
+            head = stream.read(1 << 16).decode("utf-8", "replace")
+    except OSError:
+        return False
+    marks = ('"groundStation": "dtsp-mission"', '"generator": "dtsp-mission"',
+             '"format": "dtsp-mission/tour"')
+    if any(mark in head for mark in marks):
+        return True
+    if head.startswith("QGC WPL 110") and isinstance(fresh, str):
+        return head.splitlines()[1:2] == fresh.splitlines()[1:2]
+    return False
+
+
+def _stale_sorties(writers, fresh: dict[str, str | bytes]) -> list[Path]:
+    """The files of earlier runs that this run's mission outputs make stale (sorties of the
+    same output it does not write again, or the single file a split run replaces by sorties),
+    to be removed with the write; UserError for a file this run would write over that
+    dtsp-mission did not write as one of them."""
+    stale = []
+    written = {Path(path).resolve() for path in fresh}
+    for output, _ in writers:
+        for path in _sortie_family(output):
+            ours = _written_by_us(path, fresh.get(str(path)) or next(iter(fresh.values()), None))
+            if path.resolve() in written:
+                if path.resolve() != Path(output).resolve() and not ours:
+                    raise UserError(f"{path} exists and is not a sortie file dtsp-mission wrote "
+                                    f"for {output}: this run's sortie would replace it; move it "
+                                    "or choose another output name")
+            elif ours and path.is_file():
+                stale.append(path)
+    return stale
 
 
 def with_loiters(targets, specs: tuple[str, ...]):

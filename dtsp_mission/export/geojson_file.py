@@ -81,7 +81,13 @@ def geojson_dict(mission: Mission) -> dict:
             features.append(_point(item.latitude_deg, item.longitude_deg,
                                    {"kind": kind, "item": index + 1, "command": int(item.command),
                                     "role": item.role, "altitude_m": item.altitude_m}))
-    return {"type": "FeatureCollection", "features": features}
+    # "generator": a foreign member (RFC 7946, 6.1) saying who wrote it, read by nothing but
+    # dtsp-mission itself (which replaces only the sortie files it wrote)
+    return {"type": "FeatureCollection", "generator": GENERATOR, "features": features}
+
+
+#: The ``generator`` member of every GeoJSON file dtsp-mission writes.
+GENERATOR = "dtsp-mission"
 
 
 class GeoJSONExporter(Exporter):

@@ -35,10 +35,12 @@ class Sortie:
     mission: Mission
 
 
-def _cuts(arc_m: np.ndarray, to_home_m: np.ndarray, count: int, first: int) -> tuple[list[int], float]:
+def _cuts(arc_m: np.ndarray, to_home_m: np.ndarray, count: int, first: int,
+          most: int | None = None) -> tuple[list[int], float]:
     """Cut the closed visiting order (legs ``arc_m[i]`` from visit i to i+1, straight distance
     home ``to_home_m``) opened before visit ``first`` into ``count`` contiguous parts of
-    near-equal estimated flight; the part starts and the longest estimate."""
+    near-equal estimated flight, each of at most ``most`` visits (no limit if None); the part
+    starts and the longest estimate."""
     n = len(arc_m)
     order = (first + np.arange(n)) % n
     legs = arc_m[order]
@@ -52,7 +54,7 @@ def _cuts(arc_m: np.ndarray, to_home_m: np.ndarray, count: int, first: int) -> t
         starts, i = [0], 0
         while True:
             j = i
-            while j + 1 < n and flight(i, j + 1) <= limit:
+            while j + 1 < n and flight(i, j + 1) <= limit and (most is None or j + 1 - i < most):
                 j += 1
             if j + 1 >= n:
                 return starts
@@ -93,9 +95,13 @@ def split_into_sorties(tour: Tour, frame: LocalFrame, targets: GeoTargets,
     arc = np.diff(np.append(s, s[0] + tour.length_m))
     to_home = np.hypot(*(tour.targets_m[order] - np.asarray(home_m, dtype=float)).T)
     last_error: Exception | None = None
-    for count in range(2, min(MAX_SORTIES, n) + 1):
+    attempts = [(count, most) for count in range(2, min(MAX_SORTIES, n) + 1)
+                for most in (None, -(-n // count))]
+    for count, most in attempts:
+        # Balanced by flight time first; where that leaves a part too large for the storage
+        # (a far target alone, the rest together), by flight time with the targets shared out.
         candidates = range(0, n, max(1, n // 64))
-        starts, _ = min((_cuts(arc, to_home, count, first) for first in candidates),
+        starts, _ = min((_cuts(arc, to_home, count, first, most) for first in candidates),
                         key=lambda result: result[1])
         pieces = []
         for k, start in enumerate(starts):

@@ -120,11 +120,13 @@ def read_csv(path: str | os.PathLike, text: str | None = None) -> GeoTargets | T
     try:
         for row in reader:
             first_line, last = last + 1, reader.line_num
-            if last > first_line:
-                # a quoted field ran over a line end: a quote left open swallows the rows after it
+            if last > first_line and any(delimiter in part for cell in row
+                                         for part in cell.splitlines()[1:]):
+                # a quoted field may span lines, but one that holds whole rows is a quote left
+                # open, which swallows the targets after it
                 raise FileFormatError(f"{path}, line {first_line}: a quoted field runs on to line "
-                                      f"{last}, taking the lines between into one cell (a quote "
-                                      "left open?); targets need one line each")
+                                      f"{last} and takes in lines that look like rows (a quote "
+                                      "left open?)")
             if any(cell.strip() for cell in row):
                 rows.append(row)
                 line_of.append(first_line)
