@@ -192,6 +192,15 @@ def _checked(request: PlanRequest) -> tuple[Targets, GeoTargets | None, LocalFra
     if settings is not None:
         settings.checked(request.rho_m)
         check_altitude_floor(geodetic, settings)
+        if settings.home_deg is not None:
+            try:
+                frame.check_extent(*settings.home_deg, "targets and home")
+            except InputError:
+                km = float(np.hypot(*frame.to_local(*settings.home_deg)[0])) / 1000
+                raise InputError(f"home ({settings.home_deg[0]:g}, {settings.home_deg[1]:g}) is "
+                                 f"{km:,.0f} km from the targets: is `home_deg` right (latitude "
+                                 "first)? A mission is flown from a home within about 150 km "
+                                 "of its targets") from None
         actions = geodetic.actions
         if settings.loiter_radius_m is not None and (actions is None
                                                      or not actions.loiter_turns.any()):

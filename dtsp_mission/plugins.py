@@ -13,16 +13,51 @@ from typing import Callable
 log = logging.getLogger(__name__)
 
 
+#: The distribution whose entry points are the built-ins: a plugin of another distribution
+#: registering the same name never replaces one.
+BUILT_IN = "dtsp-mission"
+
+
+def _distribution(entry_point) -> str:
+    dist = entry_point.dist
+    return dist.metadata["Name"] if dist is not None else "?"
+
+
+def _in_order(group: str) -> list:
+    """The entry points of ``group`` by name, a built-in before any other of its name."""
+    return sorted(entry_points(group=group),
+                  key=lambda e: (e.name, _distribution(e).lower() != BUILT_IN))
+
+
+def clashes(group: str) -> list[tuple[str, str, str]]:
+    """(name, distribution ignored, distribution kept) for every entry point of ``group``
+    that registers a name another already has (a built-in's, or an earlier plugin's): it is
+    ignored, and said so."""
+    kept: dict[str, str] = {}
+    found = []
+    for entry_point in _in_order(group):
+        owner = _distribution(entry_point)
+        if entry_point.name in kept:
+            found.append((entry_point.name, owner, kept[entry_point.name]))
+        else:
+            kept[entry_point.name] = owner
+    return found
+
+
 def load_group(group: str, accepts: Callable[[object], bool],
                expected: str) -> dict[str, object | Exception]:
-    """Every entry point of ``group`` by name, loaded; a broken one maps to its error.
+    """Every entry point of ``group`` by name, loaded; a broken one maps to its error.  A
+    built-in wins over a plugin of the same name (:func:`clashes`), whether or not that plugin
+    loads.
 
     ``accepts`` says whether a loaded object is a valid plugin of the group; ``expected`` names
     what it should be, for the error message.
     """
     found: dict[str, object | Exception] = {}
-    for entry_point in sorted(entry_points(group=group), key=lambda e: e.name):
+    for entry_point in _in_order(group):
         if entry_point.name in found:
+            log.warning("%s plugin %r of %s is ignored: the name is taken (built-ins win)",
+                        group, entry_point.name, _distribution(entry_point))
             continue
         try:
             loaded = entry_point.load()
@@ -39,7 +74,7 @@ def origins(group: str) -> dict[str, str]:
     """For each entry point of ``group``, the distribution that provides it ("name version"),
     without loading anything."""
     found: dict[str, str] = {}
-    for entry_point in sorted(entry_points(group=group), key=lambda e: e.name):
+    for entry_point in _in_order(group):
         dist = entry_point.dist
         found.setdefault(entry_point.name,
                          f"{dist.metadata['Name']} {dist.version}" if dist is not None else "?")

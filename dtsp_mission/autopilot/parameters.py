@@ -158,12 +158,13 @@ def with_current_names(values: dict[str, float], where: str = "parameters") -> d
 
 def check_autopilot_names(values: dict[str, float], autopilot: str, where: str) -> None:
     """:class:`FileFormatError` when a parameter file for ``autopilot`` ("ardupilot" or
-    "px4") holds the other autopilot's navigation parameters: they would be ignored, and the
-    mission designed for a stock aircraft."""
+    "px4") holds the other autopilot's navigation parameters and none of its own: they would
+    be ignored, and the mission designed for a stock aircraft."""
     foreign, theirs, ours = ((PX4_NAMES, "PX4", "ardupilot") if autopilot != "px4"
                              else (NAMES + tuple(ARDUPLANE_OLD_NAMES), "ArduPlane", "px4"))
+    own = PX4_NAMES if autopilot == "px4" else NAMES + tuple(ARDUPLANE_OLD_NAMES)
     found = [name for name in values if name in foreign]
-    if found:
+    if found and not any(name in own for name in values):
         other = "px4" if ours == "ardupilot" else "ardupilot"
         raise FileFormatError(f"{where}: holds {theirs} parameters ({', '.join(found[:3])}), "
                               f"but the mission is for {'PX4' if ours == 'px4' else 'ArduPilot'}: "

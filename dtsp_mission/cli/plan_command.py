@@ -273,12 +273,13 @@ def plan(targets_file, random_count, area_file, seed, origin, rho_m, airspeed_m_
                    remove=stale)
     for output, description, _ in rendered:
         say(f"wrote {output} ({description})")
-    for path in stale:
-        say(f"removed {path} (written by an earlier run for this output, no longer current)")
         if description == "plot":
             record(plot=str(output))
         else:
             console.current().summary.setdefault("files", []).append(str(output))
+    for path in sorted(stale):
+        say(f"removed {path} (written by an earlier run for this output, no longer current)")
+        console.current().summary.setdefault("removed", []).append(str(path))
     if simulate:
         from ..sim.fly import planned_targets
         airframe, _, _ = airframe_from(vehicle_params_file, airspeed_m_s, None, l1_period_s,
@@ -349,15 +350,20 @@ def with_loiters(targets, specs: tuple[str, ...]):
         label, _, count = spec.rpartition(":") if ":" in spec else (spec, "", "1")
         index = _target_index(label.strip(), names, len(targets))
         try:
-            turns[index] = check_loiter_turns(float(count), f"--loiter {spec}")
+            number = float(count)
         except ValueError:
             raise UserError(f"--loiter {spec}: TURNS must be a whole number, got {count!r}") from None
+        turns[index] = check_loiter_turns(number, f"--loiter {spec}")
     base = targets.actions if targets.actions is not None else TargetActions.none(len(targets))
     return replace(targets, actions=base.with_options(loiter_turns=turns))
 
 
 def _target_index(label: str, names: tuple[str, ...], count: int) -> int:
     if label in names:
+        rows = [k + 1 for k, name in enumerate(names) if name == label]
+        if len(rows) > 1:
+            raise UserError(f"--loiter {label!r}: {len(rows)} targets have that name (numbers "
+                            f"{', '.join(map(str, rows))}); give the number of the one to circle")
         return names.index(label)
     if label.isdigit() and 1 <= int(label) <= count:
         return int(label) - 1
@@ -445,9 +451,13 @@ def _report_tour(result: PlanResult) -> None:
     if tour.report.get("merged_targets"):
         note(f"{tour.report['merged_targets']} targets lie within "
                    f"{MERGE_RESOLUTION_RHO:g} rho of another and are visited as one")
-    say(f"  certified lower bound (1-tree) {bound.one_tree_m:,.1f} m: ratio "
-               f"{tour.length_m / bound.one_tree_m:.3f}; estimate for uniform targets "
-               f"{bound.stochastic_m:,.1f} m: ratio {tour.length_m / bound.stochastic_m:.3f}")
+    if bound.one_tree_m > 1e-3 * tour.rho_m:
+        say(f"  certified lower bound (1-tree) {bound.one_tree_m:,.1f} m: ratio "
+            f"{tour.length_m / bound.one_tree_m:.3f}; estimate for uniform targets "
+            f"{bound.stochastic_m:,.1f} m: ratio {tour.length_m / bound.stochastic_m:.3f}")
+    else:       # (nearly) one point: any closed tour is a turn circle, and no ratio means much
+        say(f"  certified lower bound (1-tree) {bound.one_tree_m:,.1f} m: the targets are as "
+            "good as one point, the tour one turn through it; no ratio to report")
     for phase in tour.report.get("phases", []):
         say(f"  phase {phase['phase']}: meta-beads of {phase['meta_bead_beads'][0]}x"
                    f"{phase['meta_bead_beads'][1]} beads, {phase['serviced']} targets, "
@@ -456,7 +466,9 @@ def _report_tour(result: PlanResult) -> None:
         shown = f"{result:,.1f} m" if isinstance(result, float) else result
         say(f"  candidate {name}: {shown}")
     improvement = tour.report.get("improvement")
-    if improvement:
+    if improvement and not improvement["start_m"] > 0:
+        say(f"  improvement: none ({improvement['stopped']})")
+    elif improvement:
         gain = (1.0 - improvement["length_m"] / improvement["start_m"]
                 if improvement["start_m"] > 0 else 0.0)
         spent = improvement["evaluations"] / max(improvement["budget"], 1)

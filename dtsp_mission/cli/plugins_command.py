@@ -8,7 +8,7 @@ import click
 
 from ..export import EXPORTER_GROUP, exporters
 from ..planning import PLANNER_GROUP, planners
-from ..plugins import origins
+from ..plugins import clashes, origins
 from ..upload import UPLOADER_GROUP, uploaders
 from .main import COMMAND_GROUP, commands
 
@@ -38,6 +38,9 @@ def inventory() -> list[dict[str, str]]:
             records.append({"group": label, "name": name, "distribution": provided_by.get(name, "?"),
                             "state": "broken" if broken else "ok",
                             "summary": repr(plugin) if broken else _summary(plugin)})
+        for name, ignored, kept in clashes(group):
+            records.append({"group": label, "name": name, "distribution": ignored,
+                            "state": "ignored", "summary": f"the name is {kept}'s"})
     return records
 
 
@@ -66,3 +69,7 @@ def plugins(as_json: bool) -> None:
     broken = sum(r["state"] == "broken" for r in records)
     if broken:
         click.echo(f"{broken} broken plugin(s): skipped by every command.", err=True)
+    for label, group, _ in GROUPS:
+        for name, ignored, kept in clashes(group):
+            click.echo(f"{label}: {name!r} of {ignored} is ignored: {kept} already provides "
+                       f"{name!r} (a built-in is never replaced)", err=True)

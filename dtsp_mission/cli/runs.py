@@ -30,10 +30,18 @@ def run_upload(mission, connection: str, via: str, verify: bool, signing_key_fil
     else:
         what = f"{len(mission.items)} mission items ({slots} mission slots)"
     say(f"uploading {what} to {connection} via {via}")
+    sent = [0]
+
+    def counted(done: int, total: int, resent: int | None = None) -> None:
+        sent[0] = done
+        progress(done, total, resent)
     try:
         report = upload_mission(mission, connection, via=via, verify=verify, signing_key=key,
-                                progress=progress, heartbeat_timeout_s=heartbeat_timeout_s,
+                                progress=counted, heartbeat_timeout_s=heartbeat_timeout_s,
                                 designed_for=designed_for, timeout_s=transfer_timeout_s)
+    except KeyboardInterrupt:
+        close()
+        raise Interrupted(_interrupted_holds(mission, sent[0], slots)) from None
     finally:
         close()
     for warning in report.warnings:
@@ -52,6 +60,26 @@ def run_upload(mission, connection: str, via: str, verify: bool, signing_key_fil
                    "transfer_s": report.transfer_s, "resent": report.resent,
                    "fresh_starts": report.fresh_starts, "verified": report.verified,
                    "round_trip_s": report.round_trip_s})
+
+
+class Interrupted(click.ClickException):
+    """Ctrl-C during an upload: what the vehicle may hold, exit 130 (as for SIGINT)."""
+
+    exit_code = 130
+
+
+def _interrupted_holds(mission, sent: int, slots: int) -> str:
+    """What a vehicle holds after an upload stopped with ``sent`` of ``slots`` items sent."""
+    from ..autopilot.commands import Autopilot
+    if sent == 0:
+        return ("interrupted before any mission item was sent: the vehicle keeps the mission it "
+                "held (if it had begun a transfer, it gives it up by itself)")
+    if mission.autopilot == Autopilot.PX4:
+        return (f"interrupted after {sent} of {slots} items were sent: PX4 stores an upload "
+                "only once it is complete, so it keeps the mission it held")
+    return (f"interrupted after {sent} of {slots} items were sent: ArduPilot writes items as "
+            "they arrive, so the vehicle may hold the first of them over the end of its earlier "
+            "mission -- do not fly it; upload again (or download it to see what it holds)")
 
 
 def run_flight_check(mission, targets, airframe, via: str, speedup: float,

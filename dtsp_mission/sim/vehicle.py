@@ -78,6 +78,8 @@ class VehicleSettings:
     #: what it answers PARAM_REQUEST_READ with (by their names; None: its autopilot's stock ones)
     parameters: VehicleParameters | PX4Parameters | None = None
     wind: Wind = CALM                 # the steady wind it flies in
+    #: MAV_TYPE its heartbeat claims (fixed wing; another type tests the uploader's check)
+    mav_type: int = MAV_TYPE_FIXED_WING
 
 
 @dataclass
@@ -271,7 +273,7 @@ class SimulatedVehicle:
 
     def _as_fixed_wing(self, heartbeat) -> None:
         flying = self.flight is not None and not self.finished.is_set()
-        heartbeat.type = MAV_TYPE_FIXED_WING
+        heartbeat.type = self.settings.mav_type
         heartbeat.autopilot = int(self.settings.autopilot)
         heartbeat.base_mode = MAV_MODE_FLAG_CUSTOM_MODE_ENABLED | (
             MAV_MODE_FLAG_AUTO_ENABLED | MAV_MODE_FLAG_SAFETY_ARMED if flying else 0)

@@ -81,6 +81,8 @@ def tour_from_dict(data: Any) -> Tour:
             raise FileFormatError(f"tour: '{key}' must be a list")
     targets = np.array([[_number(t, "x_m", f"targets[{i}]"), _number(t, "y_m", f"targets[{i}]")]
                         for i, t in enumerate(_records(data["targets"], "targets"))]).reshape(-1, 2)
+    if len(targets) == 0:
+        raise FileFormatError("tour: it visits no targets (a tour goes through at least one)")
     visit_s = np.full(len(targets), np.nan)
     for k, visit in enumerate(_records(data["visits"], "visits")):
         target = visit.get("target")
@@ -111,6 +113,11 @@ def tour_from_dict(data: Any) -> Tour:
         else:
             raise FileFormatError(f"{where}: 'type' must be \"line\" or \"arc\", got {kind!r}")
     chain = SegmentChain(np.array(starts).reshape(-1, 3), np.array(lengths), np.array(curvatures))
+    if "length_m" in data:
+        stated = _number(data, "length_m", "tour")
+        if abs(stated - chain.length_m) > 1e-6 * max(rho, chain.length_m):
+            raise FileFormatError(f"tour: 'length_m' says {stated:,.6g} m, but its segments are "
+                                  f"{chain.length_m:,.6g} m long")
     planner = data.get("planner") or {}
     if not isinstance(planner, dict):
         raise FileFormatError("tour: 'planner' must be an object")

@@ -93,9 +93,18 @@ def vehicle_warnings(mission: VehicleMission, info: VehicleInfo,
                         f"vehicle runs {_autopilot_name(info.autopilot)}: plan again with "
                         f"`autopilot` {'px4' if info.autopilot == Autopilot.PX4 else 'ardupilot'}",
                         "nothing was sent; the vehicle keeps its mission")
+    if info.vehicle_type is not None and info.vehicle_type not in FIXED_WING_TYPES:
+        raise LinkError(f"the vehicle is {_vehicle_type_name(info.vehicle_type)} (MAV_TYPE "
+                        f"{info.vehicle_type} in its heartbeat); these missions are for fixed "
+                        "wings: is this the right vehicle?", "nothing was sent; the vehicle keeps "
+                        "its mission")
     warnings = []
     if not info.checked:
         return ["the vehicle's parameters and home were not checked (this uploader cannot ask)"]
+    unread = [name for name in info.asked if name not in info.parameters]
+    if unread:
+        warnings.append(f"could not read {', '.join(unread)} from the vehicle in time: "
+                        "not compared with what the mission was designed for")
     if info.parameters:
         expected = designed_parameters(mission, designed_for)
         on_vehicle = expected.with_values(info.parameters)
@@ -118,6 +127,29 @@ def vehicle_warnings(mission: VehicleMission, info: VehicleInfo,
                             f"({info.home_deg[0]:.6f}, {info.home_deg[1]:.6f}): is this the right "
                             "vehicle and the right plan?")
     return warnings
+
+
+#: MAV_TYPEs that fly fixed-wing missions: fixed wing and the VTOL types (19-25).
+FIXED_WING_TYPES = {1, *range(19, 26)}
+
+
+def _vehicle_type_name(value: int) -> str:
+    from pymavlink.dialects.v20 import ardupilotmega
+    entry = ardupilotmega.enums["MAV_TYPE"].get(value)
+    name = entry.name.replace("MAV_TYPE_", "").replace("_", " ").lower() if entry else "unknown"
+    return f"a {name}"
+
+
+def _unstated_for_ardupilot(mission: VehicleMission) -> str:
+    """The note for a mission file that does not say its autopilot, sent to an ArduPilot."""
+    px4_only = sorted({int(i.command) for i in mission.items
+                       if int(i.command) in (int(Command.DO_GIMBAL_MANAGER_PITCHYAW),
+                                             int(Command.IMAGE_START_CAPTURE))})
+    signs = (f": it holds commands only PX4 acts on ({', '.join(map(str, px4_only))}), so it was "
+             "likely made for PX4" if px4_only else "")
+    return ("the file does not say its autopilot (QGC WPL 110) and was sent as an ArduPilot "
+            f"mission{signs}; check it was designed for ArduPilot (its waypoints are placed "
+            "for the autopilot's guidance)")
 
 
 def _unstated_for_px4(mission: VehicleMission) -> str:
@@ -172,8 +204,8 @@ def upload_mission(mission: VehicleMission, connection: str, via: str = "pymavli
             # A .waypoints file does not say its autopilot: it is meant for this vehicle's.
             mission = replace(mission, autopilot=Autopilot(info.autopilot), autopilot_stated=True)
             wire = to_wire(mission)
-            if mission.autopilot == Autopilot.PX4:
-                unstated.append(_unstated_for_px4(mission))
+            unstated.append(_unstated_for_px4(mission) if mission.autopilot == Autopilot.PX4
+                            else _unstated_for_ardupilot(mission))
         warnings = tuple(unstated + vehicle_warnings(mission, info, designed_for)
                          + [f"the file also holds {what}: NOT sent (this uploads mission items "
                             "only; send it with QGroundControl)" for what in mission.not_carried])

@@ -79,6 +79,7 @@ class PymavlinkUploader(Uploader):
                 autoreconnect=False)
         except Exception as error:  # pymavlink raises OSError, ValueError, serial errors ...
             raise LinkError(f"cannot open the connection {self.connection!r}: {error}") from None
+        self._guard_link()
         if self.signing_key is not None:
             self._link.setup_signing(self.signing_key, sign_outgoing=True)
         self._last_heartbeat = 0.0
@@ -86,6 +87,33 @@ class PymavlinkUploader(Uploader):
         self._unsigned = 0
         self._status_texts: list[str] = []
         self._wait_for_vehicle()
+
+    def _guard_link(self) -> None:
+        """Make a link that closes under us (a TCP vehicle killed, a serial cable pulled) a
+        :class:`LinkError` saying so, wherever it is read or written."""
+        link = self._link
+        raw_write, raw_recv = link.write, link.recv
+
+        def closed(error: OSError) -> LinkError:
+            return LinkError(f"the link to the vehicle at {self.connection} closed "
+                             f"({error.strerror or error.__class__.__name__})")
+
+        def write(buffer):
+            try:
+                return raw_write(buffer)
+            except LinkError:
+                raise
+            except OSError as error:
+                raise closed(error) from None
+
+        def recv(*args, **kwargs):
+            try:
+                return raw_recv(*args, **kwargs)
+            except LinkError:
+                raise
+            except OSError as error:
+                raise closed(error) from None
+        link.write, link.recv = write, recv
 
     def close(self) -> None:
         link = getattr(self, "_link", None)
@@ -137,6 +165,7 @@ class PymavlinkUploader(Uploader):
                     and message.autopilot != MAV_AUTOPILOT_INVALID:
                 self._target = (message.get_srcSystem(), message.get_srcComponent())
                 self._autopilot = int(message.autopilot)
+                self._vehicle_type = int(message.type)
                 raw = bytes(message.get_msgbuf())
                 self._vehicle_signs = raw[:1] == b"\xfd" and bool(raw[2] & 0x01)   # signed flag
                 return
@@ -217,7 +246,8 @@ class PymavlinkUploader(Uploader):
                     break
             interval = (min(1.0, interval * 2) if not answered else
                         max(0.05, 2 * timer.timeout_s) if timer.srtt_s is not None else 0.1)
-        return VehicleInfo(self._autopilot, home, values, True, wind)
+        return VehicleInfo(self._autopilot, home, values, True, wind,
+                           getattr(self, "_vehicle_type", None), tuple(parameter_names))
 
     # -- the mission protocol ------------------------------------------------------------------
 

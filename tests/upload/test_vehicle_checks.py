@@ -141,3 +141,24 @@ def test_the_plan_file_carries_the_design_wind(tmp_path):
     path.write_text(exporter_for(path).render(designed))
     assert read_mission(path).design_wind == (6.0, 250.0)
     assert designed.for_vehicle().design_wind == (6.0, 250.0)
+
+
+def test_a_vehicle_that_is_no_fixed_wing_is_refused_before_anything_is_sent(mission, start_vehicle):
+    vehicle = start_vehicle(mission, mav_type=2)            # MAV_TYPE_QUADROTOR
+    with pytest.raises(LinkError) as caught:
+        upload_mission(mission, f"udpout:127.0.0.1:{vehicle.port}")
+    assert "the vehicle is a quadrotor (MAV_TYPE 2" in str(caught.value)
+    assert "nothing was sent" in str(caught.value)
+    assert vehicle.uploads == 0
+    # a VTOL flies fixed-wing missions
+    vtol = start_vehicle(mission, mav_type=22)
+    assert upload_mission(mission, f"udpout:127.0.0.1:{vtol.port}").verified
+
+
+def test_a_file_without_its_autopilot_sent_to_ardupilot_says_so(mission, start_vehicle):
+    unstated = replace(mission, autopilot_stated=False)
+    vehicle = start_vehicle(mission)
+    report = upload_mission(unstated, f"udpout:127.0.0.1:{vehicle.port}")
+    assert report.verified
+    assert any("does not say its autopilot" in w and "sent as an ArduPilot mission" in w
+               for w in report.warnings)
