@@ -4,10 +4,10 @@ from __future__ import annotations
 
 import click
 
-from .options import FiniteFloatRange, UserError, reports_errors, seed_option
+from .options import LIMITS, FiniteFloatRange, UserError, reports_errors, seed_option
 
 
-bench_radius_option = click.option("--radius", "rho_m", type=float, default=100.0,
+bench_radius_option = click.option("--radius", "rho_m", type=LIMITS["radius"], default=100.0,
                                    show_default=True, help="Turn radius in metres.")
 
 
@@ -25,7 +25,7 @@ def bench() -> None:
 @click.option("--ompl-pairs", type=click.IntRange(1), default=200_000, show_default=True,
               help="How many of them OMPL computes, one Python call each.")
 @bench_radius_option
-@click.option("--half-width", "half_width_m", type=float, default=1000.0, show_default=True,
+@click.option("--half-width", "half_width_m", type=LIMITS["extent"], default=1000.0, show_default=True,
               help="Positions are uniform in a square of side twice this, in metres.")
 @click.option("--repeats", type=click.IntRange(1), default=5, show_default=True)
 @seed_option
@@ -57,7 +57,7 @@ def _sizes(ctx, param, value: str) -> list[int]:
 @click.option("--seeds", type=click.IntRange(1), default=3, show_default=True,
               help="Instances (seeds 0..N-1) per size.")
 @bench_radius_option
-@click.option("--side", "side_m", type=float, default=5000.0, show_default=True,
+@click.option("--side", "side_m", type=LIMITS["extent"], default=5000.0, show_default=True,
               help="Side of the square the targets are uniform in, metres.")
 @click.option("--planners", "names", default=None,
               help="Planners to compare, comma separated (default: every installed one).")

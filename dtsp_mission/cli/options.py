@@ -104,6 +104,7 @@ LIMITS = {
     "seed": Quantity("", 0, 2**32 - 1, integer=True),
     "count": Quantity("targets", 1, 1_000_000, integer=True),
     "pitch": Quantity("deg", -90.0, 90.0),
+    "extent": Quantity("m", 0.0, 1_000_000.0, low_open=True),   # a benchmark site's size
 }
 
 radius_option = click.option(

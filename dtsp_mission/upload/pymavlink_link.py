@@ -63,6 +63,19 @@ def _command_name(command: int) -> str:
         return f"command {command}"
 
 
+def _at_end(stream) -> bool:
+    """Whether a (non-blocking) TCP socket's peer has closed or reset the connection."""
+    import select
+    import socket
+    try:
+        readable, _, _ = select.select([stream], [], [], 0)
+        return bool(readable) and stream.recv(1, socket.MSG_PEEK) == b""
+    except BlockingIOError:
+        return False
+    except OSError:
+        return True
+
+
 class PymavlinkUploader(Uploader):
     """Mission upload and download with pymavlink (MAVLink 2, optional signing)."""
 
@@ -106,13 +119,20 @@ class PymavlinkUploader(Uploader):
             except OSError as error:
                 raise closed(error) from None
 
+        stream = link.port if isinstance(link, mavutil.mavtcp) else None
+
         def recv(*args, **kwargs):
             try:
-                return raw_recv(*args, **kwargs)
+                data = raw_recv(*args, **kwargs)
             except LinkError:
                 raise
             except OSError as error:
                 raise closed(error) from None
+            if not data and stream is not None and _at_end(stream):
+                # pymavlink reads a TCP peer's end (or reset) as "no data yet"
+                raise LinkError(f"the link to the vehicle at {self.connection} closed (the "
+                                "vehicle ended the TCP connection)")
+            return data
         link.write, link.recv = write, recv
 
     def close(self) -> None:

@@ -360,3 +360,33 @@ def test_a_plugin_never_replaces_a_built_in(site, tmp_path):
                              capture_output=True, text=True, timeout=120)
     assert planned.returncode == 0, planned.stderr
     assert json.loads((tmp_path / "p.plan").read_text())["fileType"] == "Plan"
+
+
+def test_a_tcp_vehicle_that_goes_away_mid_talk_is_a_message(site):
+    """A vehicle on TCP (ArduPilot SITL's link) that answers with heartbeats and then drops
+    the connection (reset): the upload says the link closed, no traceback."""
+    import socket
+    import struct
+    import threading
+
+    from pymavlink.dialects.v20 import ardupilotmega as mavlink
+
+    server = socket.socket()
+    server.bind(("127.0.0.1", 0))
+    server.listen(1)
+    port = server.getsockname()[1]
+
+    def vehicle():
+        connection, _ = server.accept()
+        mav = mavlink.MAVLink(None, srcSystem=1, srcComponent=1)
+        for _ in range(3):
+            connection.sendall(mav.heartbeat_encode(1, 3, 0, 0, 3).pack(mav))
+        connection.recv(4096)                         # the ground station's first words
+        connection.setsockopt(socket.SOL_SOCKET, socket.SO_LINGER, struct.pack("ii", 1, 0))
+        connection.close()                            # RST: as a killed SITL
+        server.close()
+    threading.Thread(target=vehicle, daemon=True).start()
+    result = run("upload", site / "base.plan", "--connect", f"tcp:127.0.0.1:{port}",
+                 "--heartbeat-timeout", 5, timeout=90)
+    assert result.returncode != 0 and "Traceback" not in result.stderr, result.stderr
+    assert "the link to the vehicle at tcp:127.0.0.1" in result.stderr and "closed" in result.stderr, result.stderr

@@ -167,3 +167,46 @@ def test_a_mutated_waypoints_file_is_read_or_refused(tmp_path, data):
     path = tmp_path / "m.waypoints"
     path.write_text(data.draw(text_mutations(mission_file(".waypoints", tmp_path))))
     _read_or_refuse(read_mission, path)
+
+
+#: A .plan as QGroundControl (4.x) saves it: every simple item with AltitudeMode, Altitude and
+#: AMSLAltAboveTerrain (null but in the terrain mode), a yaw of null, a terrain-mode item in
+#: frame GLOBAL (AMSL) beside relative ones.
+QGC_PLAN = {
+    "fileType": "Plan", "groundStation": "QGroundControl", "version": 1,
+    "geoFence": {"circles": [], "polygons": [], "version": 2},
+    "rallyPoints": {"points": [], "version": 2},
+    "mission": {
+        "cruiseSpeed": 15, "firmwareType": 12, "globalPlanAltitudeMode": 1, "hoverSpeed": 5,
+        "plannedHomePosition": [47.3977507, 8.5456074, 487.9], "vehicleType": 1, "version": 2,
+        "items": [
+            {"AMSLAltAboveTerrain": None, "Altitude": 50, "AltitudeMode": 1, "autoContinue": True,
+             "command": 22, "doJumpId": 1, "frame": 3,
+             "params": [15, 0, 0, None, 47.3977507, 8.5456074, 50], "type": "SimpleItem"},
+            {"AMSLAltAboveTerrain": None, "Altitude": 50, "AltitudeMode": 1, "autoContinue": True,
+             "command": 16, "doJumpId": 2, "frame": 3,
+             "params": [0, 0, 0, None, 47.3999019, 8.5458096, 50], "type": "SimpleItem"},
+            {"AMSLAltAboveTerrain": 537.9, "Altitude": 50, "AltitudeMode": 3, "autoContinue": True,
+             "command": 16, "doJumpId": 3, "frame": 0,
+             "params": [0, 0, 0, None, 47.3999917, 8.5502736, 537.9], "type": "SimpleItem"},
+            {"autoContinue": True, "command": 178, "doJumpId": 4, "frame": 2,
+             "params": [1, 18, -1, 0, 0, 0, 0], "type": "SimpleItem"},
+            {"autoContinue": True, "command": 20, "doJumpId": 5, "frame": 2,
+             "params": [0, 0, 0, 0, 0, 0, 0], "type": "SimpleItem"}]}}
+
+
+def test_a_plan_as_qgroundcontrol_saves_it_is_read(tmp_path):
+    path = tmp_path / "qgc.plan"
+    path.write_text(json.dumps(QGC_PLAN, indent=4))
+    mission = read_mission(path)
+    assert [int(i.command) for i in mission.items] == [22, 16, 16, 178, 20]
+    assert mission.height_above_home_m(mission.items[2]) == 537.9 - 487.9
+    _packs(mission)
+
+
+@FUZZ
+@given(data=st.data())
+def test_a_mutated_qgroundcontrol_plan_is_read_or_refused(tmp_path, data):
+    path = tmp_path / "qgc.plan"
+    path.write_text(data.draw(json_mutations(QGC_PLAN)))
+    _read_or_refuse(read_mission, path)
