@@ -81,8 +81,15 @@ def test_fenced_plan_is_imported_by_mavsdk_with_fence_and_rally(site_files, mavs
     assert len(vertices) >= 3 and all(int(i.param1) == len(vertices) for i in vertices)
     rally = [i for i in imported.rally_items if i.command == 5100]         # NAV_RALLY_POINT
     assert len(rally) == 1
-    # upload reads it as a mission like any .plan
-    assert read_mission(site_files / "site.fence.plan").items == read_mission(site_files / "site.plan").items
+    # upload reads it as a mission like any .plan, and its fence and rally point as MAVSDK does
+    fenced = read_mission(site_files / "site.fence.plan")
+    assert fenced.items == read_mission(site_files / "site.plan").items
+    ours = [(i.command, round(i.latitude_deg * 1e7), round(i.longitude_deg * 1e7), i.params[0])
+            for i in fenced.fence]
+    theirs = [(i.command, i.x, i.y, i.param1) for i in imported.geofence_items]
+    assert ours == theirs
+    assert [(i.command, round(i.latitude_deg * 1e7), round(i.longitude_deg * 1e7), i.altitude_m)
+            for i in fenced.rally] == [(i.command, i.x, i.y, i.z) for i in imported.rally_items]
 
 
 def test_fence_holds_the_whole_path_with_the_margin(tmp_path):

@@ -121,9 +121,6 @@ class VehicleMission:
     autopilot_stated: bool = True
     #: the wind the mission was designed for: (m/s, degrees true it comes from); None: unknown
     design_wind: tuple[float, float] | None = None
-    #: what the file holds beside the mission items, which an upload of the items does not
-    #: carry ("a geofence of 1 polygon", "1 rally point")
-    not_carried: tuple[str, ...] = ()
     #: the targets it was planned for, in visiting order (a plan file written by dtsp-mission
     #: carries them); empty: unknown
     targets: tuple[MissionTarget, ...] = ()
@@ -131,6 +128,10 @@ class VehicleMission:
     #: (:class:`~dtsp_mission.autopilot.parameters.VehicleParameters` or ``PX4Parameters``;
     #: a plan file written by dtsp-mission carries them); None: unknown
     designed_for: Any = None
+    #: the geofence, as the items of MAV_MISSION_TYPE_FENCE (polygon vertices, circles, a
+    #: return point: :func:`fence_items`), and the rally points (MAV_MISSION_TYPE_RALLY)
+    fence: tuple[MissionItem, ...] = ()
+    rally: tuple[MissionItem, ...] = ()
 
     def problems(self) -> list[str]:
         """What no autopilot would take, or no operator would fly, from this mission: a home or
@@ -212,3 +213,36 @@ class VehicleMission:
                 low.append(f"item {number} (command {int(item.command)}) at "
                            f"{self.height_above_home_m(item):g} m above home")
         return low
+
+
+# -- geofence and rally points -----------------------------------------------------------------
+
+#: MAV_CMD of the geofence items (MAV_MISSION_TYPE_FENCE) and of a rally point (_RALLY).
+FENCE_RETURN_POINT, FENCE_VERTEX_INCLUSION, FENCE_VERTEX_EXCLUSION = 5000, 5001, 5002
+FENCE_CIRCLE_INCLUSION, FENCE_CIRCLE_EXCLUSION, RALLY_POINT = 5003, 5004, 5100
+
+
+def fence_items(polygons, circles, breach_return=None) -> tuple[MissionItem, ...]:
+    """The geofence as MAVLink sends it (QGroundControl's encoding): per polygon
+    ``(inclusion, [(lat, lon), ...])`` one vertex item each, param1 the vertex count, frame
+    GLOBAL; per circle ``(inclusion, (lat, lon), radius_m)`` one item, param1 the radius;
+    ``breach_return`` ``(lat, lon, alt)`` a return point."""
+    items = []
+    if breach_return is not None:
+        items.append(MissionItem(FENCE_RETURN_POINT, int(Frame.GLOBAL_RELATIVE_ALT),
+                                 (0.0, 0.0, 0.0, 0.0), *map(float, breach_return)))
+    for inclusion, vertices in polygons:
+        command = FENCE_VERTEX_INCLUSION if inclusion else FENCE_VERTEX_EXCLUSION
+        items += [MissionItem(command, int(Frame.GLOBAL), (float(len(vertices)), 0.0, 0.0, 0.0),
+                              float(lat), float(lon), 0.0) for lat, lon in vertices]
+    for inclusion, (lat, lon), radius in circles:
+        command = FENCE_CIRCLE_INCLUSION if inclusion else FENCE_CIRCLE_EXCLUSION
+        items.append(MissionItem(command, int(Frame.GLOBAL), (float(radius), 0.0, 0.0, 0.0),
+                                 float(lat), float(lon), 0.0))
+    return tuple(items)
+
+
+def rally_items(points) -> tuple[MissionItem, ...]:
+    """Rally points ``(lat, lon, alt above home)`` as MAVLink sends them."""
+    return tuple(MissionItem(RALLY_POINT, int(Frame.GLOBAL_RELATIVE_ALT), (0.0, 0.0, 0.0, 0.0),
+                             float(lat), float(lon), float(alt)) for lat, lon, alt in points)

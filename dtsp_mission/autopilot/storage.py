@@ -260,8 +260,10 @@ class MissionStore:
     """
 
     def __init__(self, autopilot: Autopilot, slots: int | None = None,
-                 home: WireItem | None = None) -> None:
+                 home: WireItem | None = None, commands: frozenset[int] | None = None) -> None:
         self.autopilot = autopilot
+        #: the commands it takes (a mission's by default; a geofence's or rally list's: theirs)
+        self.commands = MISSION_COMMANDS if commands is None else commands
         self.slots = capacity(autopilot) if slots is None else slots
         self.home = home
         self.in_place = autopilot == Autopilot.ARDUPILOTMEGA
@@ -300,13 +302,15 @@ class MissionStore:
         not take (home's placeholder at seq 0 aside); ERROR for a seq beyond the end of what is
         stored (ArduPilot) or out of order (PX4)."""
         if item.seq > 0 or self.home is None:
-            if item.command not in MISSION_COMMANDS:
+            if item.command not in self.commands:
                 return UNSUPPORTED
             if item.frame not in MISSION_FRAMES:
                 return UNSUPPORTED_FRAME
-            if self.autopilot == Autopilot.PX4 and px4_refusal(item) is not None:
+            if (self.commands is MISSION_COMMANDS and self.autopilot == Autopilot.PX4
+                    and px4_refusal(item) is not None):
                 return px4_refusal(item)
-        stored = replace(stored_item(item, self.autopilot), current=0)
+        stored = (replace(stored_item(item, self.autopilot), current=0)
+                  if self.commands is MISSION_COMMANDS else replace(item, current=0))
         if not self.in_place:
             if self._staged is None or item.seq != len(self._staged):
                 return ERROR

@@ -124,3 +124,44 @@ def describe_vehicle(on_vehicle: list[WireItem] | None, planned: list[WireItem],
 __all__ = ["COMPARED", "MISSION_TYPE_MISSION", "WireItem", "describe_vehicle", "differences",
            "first_mission_seq", "holds",
            "from_wire", "home_placeholder", "to_wire"]
+
+
+def other_to_wire(items, mission_type: int) -> list[WireItem]:
+    """Geofence or rally items (``mission_type`` 1 or 2) as sent: seq from 0, no home slot."""
+    return [WireItem.normalised(seq, item.frame, item.command, 0, item.autocontinue,
+                                *item.params, degrees_to_e7(item.latitude_deg),
+                                degrees_to_e7(item.longitude_deg), item.altitude_m, mission_type)
+            for seq, item in enumerate(items)]
+
+
+#: Frames that mean the same for a geofence or rally item (integer and float forms).
+_SAME_FRAME = {5: 0, 6: 3, 11: 10}
+
+
+def other_differences(planned: list[WireItem], on_vehicle: list[WireItem],
+                      limit: int = 5) -> list[str]:
+    """How a downloaded geofence or rally list differs from the one sent (empty if equal):
+    the same commands at the same positions (1e-7 deg), parameters as 32-bit floats, the
+    altitude within the metre autopilots keep rally altitudes in."""
+    problems = []
+    if len(planned) != len(on_vehicle):
+        problems.append(f"the vehicle holds {len(on_vehicle)} items, {len(planned)} were sent")
+    for sent, held in zip(planned, on_vehicle):
+        changed = [name for name in ("command", "x", "y") if getattr(sent, name) != getattr(held, name)]
+        changed += [f"param{k}" for k in (1, 2) if abs(getattr(sent, f"param{k}")
+                                                     - getattr(held, f"param{k}")) > 1e-3]
+        if sent.command == RALLY_POINT_COMMAND or sent.command == 5000:
+            if abs(sent.z - held.z) > 1.0:
+                changed.append("z")
+            if _SAME_FRAME.get(sent.frame, sent.frame) != _SAME_FRAME.get(held.frame, held.frame):
+                changed.append("frame")
+        if changed:
+            problems.append(f"item {sent.seq} differs in " + ", ".join(
+                f"{name} ({getattr(held, name)!r} instead of {getattr(sent, name)!r})"
+                for name in changed))
+    if len(problems) > limit:
+        problems = problems[:limit] + [f"... and {len(problems) - limit} more differences"]
+    return problems
+
+
+RALLY_POINT_COMMAND = 5100

@@ -49,17 +49,16 @@ def run_upload(mission, connection: str, via: str, verify: bool, signing_key_fil
     fresh = f", {report.fresh_starts} fresh starts" if report.fresh_starts else ""
     line = (f"the vehicle accepted {report.items} mission slots in {report.seconds:.2f} s "
             f"({report.resent} messages resent{fresh})")
-    held = ("exactly the planned mission" if not mission.not_carried else
-            "exactly the planned mission items (not what was not sent: "
-            + ", ".join(mission.not_carried) + ")")
-    say(line + (f"; downloaded back: it holds {held}" if report.verified
+    say(line + ("; downloaded back: it holds exactly the planned mission" if report.verified
                 else "; not verified (--no-verify)"))
+    for part in report.parts:
+        say(f"  {part}")
     if report.note:
         note(report.note)
     record(upload={"via": report.via, "mission_slots": report.items, "seconds": report.seconds,
                    "transfer_s": report.transfer_s, "resent": report.resent,
                    "fresh_starts": report.fresh_starts, "verified": report.verified,
-                   "round_trip_s": report.round_trip_s})
+                   "round_trip_s": report.round_trip_s, "parts": list(report.parts)})
 
 
 class Interrupted(click.ClickException):

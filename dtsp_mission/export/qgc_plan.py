@@ -17,7 +17,7 @@ from typing import Any
 from ..errors import FileFormatError, TourInvalidError
 from ..files import read_json
 from ..mission import Autopilot, Home, Mission, MissionItem, VehicleMission
-from ..autopilot.mission import MissionTarget
+from ..autopilot.mission import MissionTarget, fence_items, rally_items
 from ..autopilot.parameters import checked_parameters
 from ..autopilot.commands import VEHICLE_TYPE_FIXED_WING
 from .base import Exporter
@@ -207,15 +207,35 @@ def _item_violations(item: Any) -> list[str]:
     return problems
 
 
-def _beside_the_items(data: dict) -> tuple[str, ...]:
-    """What a (checked) plan holds beside its mission items: geofence shapes, rally points."""
-    fence, rally = data["geoFence"], data["rallyPoints"]["points"]
-    shapes = [f"{len(fence[key])} {key[:-1] if len(fence[key]) == 1 else key}"
-              for key in ("polygons", "circles") if fence[key]]
-    held = [f"a geofence of {' and '.join(shapes)}"] if shapes else []
-    if rally:
-        held.append(f"{len(rally)} rally point{'s' if len(rally) > 1 else ''}")
-    return tuple(held)
+def _fence_and_rally(path, data: dict):
+    """The plan's geofence and rally points as MAVLink items (:func:`fence_items`,
+    :func:`rally_items`); :class:`FileFormatError` for a shape QGroundControl would not load."""
+    fence, polygons, circles = data["geoFence"], [], []
+    for k, entry in enumerate(fence["polygons"]):
+        vertices = entry.get("polygon") if isinstance(entry, dict) else None
+        if not (isinstance(vertices, list) and len(vertices) >= 3 and all(
+                isinstance(v, list) and len(v) == 2 and all(map(_is_number, v)) for v in vertices)):
+            raise FileFormatError(f"{path}: geoFence.polygons[{k}] must hold a 'polygon' of at "
+                                  "least 3 [lat, lon] vertices")
+        polygons.append((bool(entry.get("inclusion", True)), [tuple(v) for v in vertices]))
+    for k, entry in enumerate(fence["circles"]):
+        circle = entry.get("circle") if isinstance(entry, dict) else None
+        centre = circle.get("center") if isinstance(circle, dict) else None
+        radius = circle.get("radius") if isinstance(circle, dict) else None
+        if not (isinstance(centre, list) and len(centre) == 2 and all(map(_is_number, centre))
+                and _is_number(radius) and radius > 0):
+            raise FileFormatError(f"{path}: geoFence.circles[{k}] must hold a 'circle' with a "
+                                  "'center' [lat, lon] and a 'radius' above 0 m")
+        circles.append((bool(entry.get("inclusion", True)), tuple(centre), float(radius)))
+    breach = fence.get("breachReturn")
+    if breach is not None and not (isinstance(breach, list) and len(breach) == 3
+                                   and all(map(_is_number, breach))):
+        raise FileFormatError(f"{path}: geoFence.breachReturn must be [lat, lon, alt]")
+    points = data["rallyPoints"]["points"]
+    for k, point in enumerate(points):
+        if not (isinstance(point, list) and len(point) == 3 and all(map(_is_number, point))):
+            raise FileFormatError(f"{path}: rallyPoints.points[{k}] must be [lat, lon, alt]")
+    return fence_items(polygons, circles, breach), rally_items(points)
 
 
 class QGCPlanExporter(Exporter):
@@ -262,8 +282,9 @@ class QGCPlanExporter(Exporter):
         design_wind = None
         if isinstance(wind, dict) and all(_is_number(wind.get(k)) for k in ("speed_m_s", "from_deg")):
             design_wind = (float(wind["speed_m_s"]), float(wind["from_deg"]))
+        fence, rally = _fence_and_rally(path, data)
         read = VehicleMission(tuple(items), Home(*mission["plannedHomePosition"]), autopilot,
-                              design_wind=design_wind, not_carried=_beside_the_items(data),
+                              design_wind=design_wind, fence=fence, rally=rally,
                               targets=_carried_targets(path, ours),
                               designed_for=_carried_aircraft(path, ours, autopilot))
         problems = read.problems()

@@ -44,8 +44,11 @@ class MissionServer:
     def __init__(self, store: MissionStore, send: Send, *, re_request_s: float = 1.0,
                  upload_timeout_s: float = 8.0, on_stored: Callable[[], None] | None = None,
                  before_item: Callable[[int], bool] | None = None,
-                 clock: Callable[[], float] = time.monotonic) -> None:
+                 clock: Callable[[], float] = time.monotonic,
+                 mission_type: int = MISSION_TYPE_MISSION) -> None:
         self.store = store
+        #: the MAV_MISSION_TYPE it serves (mission, FENCE 1, RALLY 2): each has its own store
+        self.mission_type = mission_type
         self._send = send
         self.re_request_s = re_request_s
         self.upload_timeout_s = upload_timeout_s
@@ -67,10 +70,6 @@ class MissionServer:
         if kind not in PROTOCOL_MESSAGES:
             return False
         source = (message.get_srcSystem(), message.get_srcComponent())
-        if getattr(message, "mission_type", MISSION_TYPE_MISSION) != MISSION_TYPE_MISSION:
-            if kind != "MISSION_ACK":
-                self._ack(source, MAV_MISSION_UNSUPPORTED, message.mission_type)
-            return True
         if kind == "MISSION_COUNT":
             self._count_received(source, message.count)
         elif kind in ("MISSION_ITEM_INT", "MISSION_ITEM"):
@@ -80,7 +79,7 @@ class MissionServer:
                 self._ack(source, MAV_MISSION_DENIED)
             else:
                 self._send(lambda e: e.mission_count_send(*source, len(self.store.items),
-                                                          MISSION_TYPE_MISSION))
+                                                          self.mission_type))
         elif kind in ("MISSION_REQUEST_INT", "MISSION_REQUEST"):
             self._serve(source, message.seq, kind == "MISSION_REQUEST")
         elif kind == "MISSION_CLEAR_ALL":
@@ -92,8 +91,9 @@ class MissionServer:
                 self._ack(source, ACCEPTED)
         return True                        # MISSION_ACK from a ground station: nothing to do
 
-    def _ack(self, target: tuple[int, int], result: int, mission_type: int = MISSION_TYPE_MISSION) -> None:
-        self._send(lambda e: e.mission_ack_send(*target, result, mission_type))
+    def _ack(self, target: tuple[int, int], result: int) -> None:
+        kind = self.mission_type
+        self._send(lambda e: e.mission_ack_send(*target, result, kind))
 
     def _count_received(self, source: tuple[int, int], count: int) -> None:
         if self.receiving and source != self._partner:
@@ -123,9 +123,9 @@ class MissionServer:
         self._last_request = self._clock()
         self.counts["requests_sent"] += 1
         if self.store.autopilot == Autopilot.ARDUPILOTMEGA:
-            self._send(lambda e: e.mission_request_send(system, component, seq, MISSION_TYPE_MISSION))
+            self._send(lambda e: e.mission_request_send(system, component, seq, self.mission_type))
         else:
-            self._send(lambda e: e.mission_request_int_send(system, component, seq, MISSION_TYPE_MISSION))
+            self._send(lambda e: e.mission_request_int_send(system, component, seq, self.mission_type))
 
     def _item_received(self, source: tuple[int, int], message) -> None:
         if not self.receiving:
@@ -153,7 +153,8 @@ class MissionServer:
             self.receiving = False
             self.counts["uploads"] += 1
             self._on_stored()
-            self._send(lambda e: e.statustext_send(MAV_SEVERITY_INFO, b"Flight plan received"))
+            if self.mission_type == MISSION_TYPE_MISSION:
+                self._send(lambda e: e.statustext_send(MAV_SEVERITY_INFO, b"Flight plan received"))
             self._ack(source, ACCEPTED)
             return
         self._request()
@@ -165,18 +166,18 @@ class MissionServer:
         items = self.store.items
         if not 0 <= seq < len(items):
             count = len(items)
-            self._send(lambda e: e.mission_count_send(*source, count, MISSION_TYPE_MISSION))
+            self._send(lambda e: e.mission_count_send(*source, count, self.mission_type))
             self._ack(source, ERROR)
             return
         i = items[seq]
         if float_form:
             self._send(lambda e: e.mission_item_send(
                 *source, i.seq, i.frame, i.command, 0, i.autocontinue, i.param1, i.param2,
-                i.param3, i.param4, i.x / 1e7, i.y / 1e7, i.z, MISSION_TYPE_MISSION))
+                i.param3, i.param4, i.x / 1e7, i.y / 1e7, i.z, self.mission_type))
         else:
             self._send(lambda e: e.mission_item_int_send(
                 *source, i.seq, i.frame, i.command, 0, i.autocontinue, i.param1, i.param2,
-                i.param3, i.param4, i.x, i.y, i.z, MISSION_TYPE_MISSION))
+                i.param3, i.param4, i.x, i.y, i.z, self.mission_type))
 
     # -- time -------------------------------------------------------------------------------
 

@@ -27,6 +27,7 @@ import numpy as np
 from pymavlink.dialects.v20 import ardupilotmega
 from pymavlink.dialects.v20 import common as mavlink2
 from pymavlink.dialects.v20.common import (MAVLINK_MSG_ID_HOME_POSITION, MAV_CMD_MISSION_START,
+                                           MAV_MISSION_UNSUPPORTED,
                                            MAV_CMD_REQUEST_MESSAGE, MAV_MODE_FLAG_AUTO_ENABLED,
                                            MAV_MODE_FLAG_CUSTOM_MODE_ENABLED,
                                            MAV_MODE_FLAG_SAFETY_ARMED, MAV_PARAM_TYPE_REAL32,
@@ -37,13 +38,20 @@ from pymavlink.dialects.v20.common import (MAVLINK_MSG_ID_HOME_POSITION, MAV_CMD
 from ..autopilot.navigation import (CALM, MODEL_STEP_S, Airframe, LocalItem, MissionFlight, Wind,
                                     launch_heading_rad, local_items)
 from ..autopilot.parameters import PX4Parameters, VehicleParameters, parameter_name, parameters_of
-from ..autopilot.storage import MissionStore, stored_item
+from ..autopilot.storage import MISSION_TYPE_MISSION, MissionStore, stored_item
 from ..frame import LocalFrame
 from ..mavsdk_log import quiet_mavsdk_log
 from ..autopilot.commands import Autopilot
 from ..autopilot.mission import Home, degrees_to_e7
 from ..autopilot.wire import WireItem, first_mission_seq, home_placeholder
-from .mission_server import MissionServer
+from .mission_server import PROTOCOL_MESSAGES, MissionServer
+
+#: MAV_MISSION_TYPE of the geofence and of the rally points.
+MISSION_TYPE_FENCE, MISSION_TYPE_RALLY = 1, 2
+#: Fence vertices and rally points the simulated vehicle keeps (ArduPlane's FENCE_TOTAL and
+#: RALLY_TOTAL ceilings are larger; enough for any fence a plan carries).
+FENCE_SLOTS, RALLY_SLOTS = 200, 20
+FENCE_COMMANDS, RALLY_COMMANDS = frozenset(range(5000, 5005)), frozenset({5100})
 from .transport import Transport, UdpTransport, open_transport
 from ..vehicle import heading_to_bearing_deg
 
@@ -80,6 +88,8 @@ class VehicleSettings:
     wind: Wind = CALM                 # the steady wind it flies in
     #: MAV_TYPE its heartbeat claims (fixed wing; another type tests the uploader's check)
     mav_type: int = MAV_TYPE_FIXED_WING
+    #: whether it keeps a geofence and rally points (MISSION_TYPE_FENCE, _RALLY)
+    fence_support: bool = True
 
 
 @dataclass
@@ -130,6 +140,16 @@ class SimulatedVehicle:
         self.server = MissionServer(self.store, self._emit, before_item=self._before_item,
                                     on_stored=self._mission_stored,
                                     upload_timeout_s=settings.upload_timeout_s)
+        # The geofence and the rally points: their own mission types and stores (taken whole,
+        # as ArduPilot's fence loader and PX4 store them); a vehicle without fence support
+        # answers them MAV_MISSION_UNSUPPORTED.
+        self.fence_store = MissionStore(Autopilot.PX4, FENCE_SLOTS, commands=FENCE_COMMANDS)
+        self.rally_store = MissionStore(Autopilot.PX4, RALLY_SLOTS, commands=RALLY_COMMANDS)
+        self.other_servers = {kind: MissionServer(store, self._emit, mission_type=kind,
+                                                  upload_timeout_s=settings.upload_timeout_s)
+                              for kind, store in ((MISSION_TYPE_FENCE, self.fence_store),
+                                                  (MISSION_TYPE_RALLY, self.rally_store))
+                              if settings.fence_support}
         self.restarts = 0
         self.log = FlightLog()
         self.flight: MissionFlight | None = None
@@ -182,6 +202,30 @@ class SimulatedVehicle:
         with self._lock:
             self.store.replace(items)
 
+    def _serve_mission_protocol(self, message) -> bool:
+        """Answer a mission-protocol message with the server of its mission type (a type it
+        does not keep: MAV_MISSION_UNSUPPORTED); True if it was one."""
+        if message.get_type() not in PROTOCOL_MESSAGES:
+            return False
+        kind = getattr(message, "mission_type", MISSION_TYPE_MISSION)
+        server = self.server if kind == MISSION_TYPE_MISSION else self.other_servers.get(kind)
+        if server is not None:
+            return server.handle(message)
+        if message.get_type() != "MISSION_ACK":
+            source = (message.get_srcSystem(), message.get_srcComponent())
+            self._emit(lambda e: e.mission_ack_send(*source, MAV_MISSION_UNSUPPORTED, kind))
+        return True
+
+    @property
+    def fence(self) -> list[WireItem]:
+        """The geofence items it holds (MISSION_TYPE_FENCE)."""
+        return list(self.fence_store.items)
+
+    @property
+    def rally(self) -> list[WireItem]:
+        """The rally points it holds (MISSION_TYPE_RALLY)."""
+        return list(self.rally_store.items)
+
     @property
     def uploads(self) -> int:
         """Uploads completed since the vehicle was created."""
@@ -220,7 +264,8 @@ class SimulatedVehicle:
         self.restarts += 1
         self._shutdown_mavsdk()
         with self._lock:
-            self.server.reset()
+            for server in (self.server, *self.other_servers.values()):
+                server.reset()
         if self._stop.wait(self.settings.restart_s):
             return                               # stopped while rebooting: stay down
         with self._lock:
@@ -287,7 +332,8 @@ class SimulatedVehicle:
                 return
             if not self._restarting:
                 with self._lock:
-                    self.server.update()
+                    for server in (self.server, *self.other_servers.values()):
+                        server.update()
             if data is None or self._restarting:
                 continue
             with self._lock:
@@ -304,7 +350,7 @@ class SimulatedVehicle:
                 with self._lock:
                     if self._restarting:
                         break
-                    if self.server.handle(message):
+                    if self._serve_mission_protocol(message):
                         continue
                 if not self._handled_here(message):
                     with self._lock:

@@ -17,6 +17,7 @@ from ..autopilot.parameters import NAMES, PX4_NAMES, PX4Parameters, VehicleParam
 from ..errors import InputError, LinkError
 from ..autopilot.commands import Command
 from ..autopilot.mission import VehicleMission
+from pymavlink.dialects.v20.common import MAV_MISSION_UNSUPPORTED
 from ..plugins import load_group, working
 from .base import VEHICLE_GIVES_UP_S, Progress, Uploader, VehicleInfo
 from ..autopilot.wire import WireItem, describe_vehicle, differences, to_wire
@@ -52,6 +53,8 @@ class UploadReport:
     fresh_starts: int = 0             # uploads started again with a new MISSION_COUNT
     round_trip_s: float | None = None # the link's smoothed round trip, where measured
     transfer_s: float = 0.0           # the upload and its verification, without connecting
+    #: the geofence and rally points of the plan, one line each: sent and verified, or why not
+    parts: tuple[str, ...] = ()
 
 
 #: A plan whose home is farther than this from the vehicle's is warned about.
@@ -206,9 +209,7 @@ def upload_mission(mission: VehicleMission, connection: str, via: str = "pymavli
             wire = to_wire(mission)
             unstated.append(_unstated_for_px4(mission) if mission.autopilot == Autopilot.PX4
                             else _unstated_for_ardupilot(mission))
-        warnings = tuple(unstated + vehicle_warnings(mission, info, designed_for)
-                         + [f"the file also holds {what}: NOT sent (this uploads mission items "
-                            "only; send it with QGroundControl)" for what in mission.not_carried])
+        warnings = tuple(unstated + vehicle_warnings(mission, info, designed_for))
         transfer_started = time.perf_counter()
         try:
             uploader.upload(wire, progress)
@@ -240,10 +241,56 @@ def upload_mission(mission: VehicleMission, connection: str, via: str = "pymavli
                 raise LinkError("the vehicle accepted the upload, but the mission downloaded "
                                 "from it differs from the plan: " + "; ".join(problems),
                                 describe_vehicle(on_vehicle, wire, mission.autopilot))
+        parts = _upload_fence_and_rally(uploader, mission, verify)
         return UploadReport(via, len(wire), time.perf_counter() - started, uploader.resent,
                             verify, warnings=warnings, fresh_starts=uploader.fresh_starts,
                             round_trip_s=_round_trip(uploader),
-                            transfer_s=time.perf_counter() - transfer_started)
+                            transfer_s=time.perf_counter() - transfer_started, parts=parts)
+
+
+#: The parts of a plan beside its mission items: (MAV_MISSION_TYPE, name, mission field).
+OTHER_PARTS = ((1, "geofence", "fence"), (2, "rally points", "rally"))
+
+
+def _upload_fence_and_rally(uploader: Uploader, mission: VehicleMission,
+                            verify: bool) -> tuple[str, ...]:
+    """Send the plan's geofence and rally points (MAV_MISSION_TYPE_FENCE, _RALLY), each
+    downloaded back and compared with ``verify``: one line per part sent.  :class:`LinkError`
+    naming the part when the vehicle refuses it (no fence support) or it does not arrive as
+    sent; the mission items are on the vehicle and verified by then, and the message says so."""
+    from ..autopilot.wire import other_differences, other_to_wire
+    done = []
+    for kind, name, field in OTHER_PARTS:
+        items = getattr(mission, field)
+        if not items:
+            continue
+        held = "the mission items are on the vehicle" + (" and verified" if verify else "")
+        if kind not in uploader.mission_types:
+            raise LinkError(f"the plan holds {name} ({len(items)} items), which the "
+                            f"{uploader.name} uploader cannot send (mission items only): use "
+                            "`via` pymavlink", held + f"; its {name} were not sent")
+        wire = other_to_wire(items, kind)
+        uploader.mission_type = kind
+        try:
+            try:
+                uploader.upload(wire)
+            except LinkError as error:
+                refused = getattr(uploader, "last_refusal", None) == MAV_MISSION_UNSUPPORTED
+                reason = ("the vehicle does not keep them (MAV_MISSION_UNSUPPORTED: no "
+                          f"{'fence' if kind == 1 else 'rally'} support)" if refused
+                          else error.reason)
+                raise LinkError(f"the {name} were not accepted: {reason}",
+                                held + f"; what {name} it holds is unknown") from None
+            if verify:
+                problems = other_differences(wire, uploader.download())
+                if problems:
+                    raise LinkError(f"the vehicle accepted the {name}, but they downloaded back "
+                                    "differently: " + "; ".join(problems),
+                                    held + f"; do not rely on its {name}")
+        finally:
+            uploader.mission_type = 0
+        done.append(f"{name}: {len(wire)} items sent" + (", downloaded back equal" if verify else ""))
+    return tuple(done)
 
 
 def _round_trip(uploader: Uploader) -> float | None:

@@ -89,6 +89,11 @@ class Uploader:
         within ``wind_wait_s`` (the default: nothing is known)."""
         return VehicleInfo()
 
+    #: The MAV_MISSION_TYPE the next transfers carry (0 mission, 1 FENCE, 2 RALLY); an
+    #: uploader that can only carry mission items leaves :attr:`mission_types` at (0,).
+    mission_type: int = 0
+    mission_types: tuple[int, ...] = (0,)
+
     def upload(self, items: list[WireItem], progress: Progress | None = None) -> None:
         """Send ``items`` (seq 0 first); returns when the vehicle accepted them."""
         raise NotImplementedError

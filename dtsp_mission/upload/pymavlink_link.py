@@ -82,6 +82,7 @@ class PymavlinkUploader(Uploader):
     name = "pymavlink"
     description = "the MAVLink mission protocol over pymavlink (MAVLink 2, signing)"
     supports_signing = True
+    mission_types = (0, 1, 2)
 
     def open(self) -> None:
         use_mavlink2()
@@ -174,7 +175,7 @@ class PymavlinkUploader(Uploader):
                 continue
             if kind == "STATUSTEXT":
                 self._status_texts = (self._status_texts + [message.text.rstrip("\0")])[-5:]
-            if kind in types and getattr(message, "mission_type", MISSION_TYPE_MISSION) == MISSION_TYPE_MISSION:
+            if kind in types and getattr(message, "mission_type", MISSION_TYPE_MISSION) == self.mission_type:
                 return message
 
     def _wait_for_vehicle(self) -> None:
@@ -276,7 +277,7 @@ class PymavlinkUploader(Uploader):
         self._link.mav.mission_item_int_send(
             system, component, item.seq, item.frame, item.command, item.current,
             item.autocontinue, item.param1, item.param2, item.param3, item.param4, item.x,
-            item.y, item.z, item.mission_type)
+            item.y, item.z, self.mission_type)
 
     def _transfer_deadline(self, count: int) -> float:
         return time.monotonic() + (self.timeout_s if self.timeout_s is not None
@@ -323,7 +324,7 @@ class PymavlinkUploader(Uploader):
         ardupilot = self._autopilot == MAV_AUTOPILOT_ARDUPILOTMEGA
         max_sent = -1
         kinds = {"MISSION_REQUEST_INT", "MISSION_REQUEST", "MISSION_ACK"}
-        self._link.mav.mission_count_send(system, component, count, MISSION_TYPE_MISSION)
+        self._link.mav.mission_count_send(system, component, count, self.mission_type)
         first_sent = {-1: time.monotonic()}   # seq -> first send (-1: the count)
         last_sent: dict[int, float] = {}
         resent: set[int] = set()              # Karn's rule: no round-trip sample from these
@@ -363,7 +364,7 @@ class PymavlinkUploader(Uploader):
                 answered = False
                 retry_at = now + timer.timeout_s
                 if highest < 0:
-                    self._link.mav.mission_count_send(system, component, count, MISSION_TYPE_MISSION)
+                    self._link.mav.mission_count_send(system, component, count, self.mission_type)
                     resent.add(-1)
                     self.resent += 1
                     continue
@@ -408,6 +409,7 @@ class PymavlinkUploader(Uploader):
             send(seq, now)
 
     def _rejection(self, result: int, items: list[WireItem], highest: int, count: int) -> LinkError:
+        self.last_refusal = result
         said = f" (the vehicle said: {' / '.join(self._status_texts)})" if self._status_texts else ""
         if result == NO_SPACE:
             return LinkError(f"the vehicle has no room for {count} mission slots "
@@ -431,7 +433,7 @@ class PymavlinkUploader(Uploader):
         while (now := time.monotonic()) < deadline:
             if now - answered > FIRST_ANSWER_S:
                 break
-            self._link.mav.mission_request_list_send(system, component, MISSION_TYPE_MISSION)
+            self._link.mav.mission_request_list_send(system, component, self.mission_type)
             asked = time.monotonic()
             message = self._receive({"MISSION_COUNT", "MISSION_ACK"},
                                     min(timer.timeout_s, max(0.0, deadline - asked)))
@@ -475,7 +477,7 @@ class PymavlinkUploader(Uploader):
             while len(asked) < window and seq < count:       # fill the window
                 if seq not in items and seq not in asked:
                     self._link.mav.mission_request_int_send(system, component, seq,
-                                                            MISSION_TYPE_MISSION)
+                                                            self.mission_type)
                     asked[seq] = now
                     tries[seq] = tries.get(seq, 0) + 1
                     if tries[seq] > 1:
@@ -518,7 +520,7 @@ class PymavlinkUploader(Uploader):
             items[got] = wire_item_from(message)
             if progress is not None:
                 progress(len(items), count, self.resent)
-        self._link.mav.mission_ack_send(system, component, 0, MISSION_TYPE_MISSION)
+        self._link.mav.mission_ack_send(system, component, 0, self.mission_type)
         return [items[seq] for seq in range(count)]
 
 class RetransmitTimer:

@@ -214,16 +214,30 @@ def test_upload_and_fly_print_one_json_summary(mission, tmp_path, start_vehicle)
     assert "simulated flight completed" in result.stderr
 
 
-def test_upload_of_a_fenced_plan_says_the_fence_and_rally_point_were_not_sent(mission, tmp_path,
-                                                                             start_vehicle):
+def test_upload_of_a_fenced_plan_sends_the_fence_and_rally_point_and_reads_them_back(
+        mission, tmp_path, start_vehicle):
+    from dtsp_mission.autopilot.wire import other_differences, other_to_wire
+    from dtsp_mission.export import read_mission
     path = tmp_path / "m.fence.plan"
     exporter_for(path).write(mission, path)
+    planned = read_mission(path)
     vehicle = start_vehicle(mission)
     result = run("upload", path, "--connect", f"udpout:127.0.0.1:{vehicle.port}")
     assert result.exit_code == 0, result.output
-    assert "geofence of 1 polygon: NOT sent" in result.output
-    assert "1 rally point: NOT sent" in result.output
-    assert "holds exactly the planned mission items (not what was not sent" in result.output
+    assert f"geofence: {len(planned.fence)} items sent, downloaded back equal" in result.output
+    assert "rally points: 1 items sent, downloaded back equal" in result.output
+    assert other_differences(other_to_wire(planned.fence, 1), vehicle.fence) == []
+    assert [(i.command, i.z) for i in vehicle.rally] == [(5100, planned.rally[0].altitude_m)]
+    # a vehicle without fence support: the mission is there, the refused part is named
+    bare = start_vehicle(mission, fence_support=False)
+    result = run("upload", path, "--connect", f"udpout:127.0.0.1:{bare.port}")
+    assert result.exit_code == 2, result.output
+    assert "the geofence were not accepted: the vehicle does not keep them" in result.output
+    assert "the mission items are on the vehicle and verified" in result.output
+    assert bare.uploads == 1 and bare.fence == []
+    # MAVSDK's uploader carries mission items only: said before anything is claimed
+    result = run("upload", path, "--connect", f"udpout:127.0.0.1:{vehicle.port}", "--via", "mavsdk")
+    assert result.exit_code == 2 and "mavsdk uploader cannot send" in result.output
 
 
 def test_a_waypoints_file_sent_to_px4_is_said_to_be_sent_as_a_px4_mission(mission, tmp_path,
