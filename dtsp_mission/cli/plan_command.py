@@ -130,8 +130,15 @@ def _duration(seconds: float) -> str:
 @click.option("--plot", "plot_file", type=click.Path(dir_okay=False), metavar="FILE",
               help="Draw targets, path and waypoints to this picture (.png, .svg, .pdf, .jpg).")
 @click.option("--upload", "connection", metavar="CONNECTION",
-              help="Upload the mission to this vehicle after writing the files "
-                   "(udpout:HOST:PORT, ...); see `dtsp-mission upload`.")
+              help="Upload the mission to this vehicle (udpout:HOST:PORT, ...; see "
+                   "`dtsp-mission upload`): its navigation parameters, home and wind estimate are "
+                   "read first and the mission designed for them (as with --from-vehicle), then "
+                   "uploaded before the files are written.")
+@click.option("--from-vehicle", "vehicle_connection", metavar="CONNECTION",
+              help="Read the vehicle's navigation parameters, home and (ArduPilot) wind estimate "
+                   "over this link and design the mission for them, without uploading; each "
+                   "value read is reported.  --home, --home-amsl, --wind and --l1-period given "
+                   "still win; --autopilot must be the vehicle's.")
 @apply(link_options)
 @click.option("--endurance", "endurance_min", type=FiniteFloatRange(min=0.0, min_open=True),
               metavar="MINUTES", help="Longest flight the aircraft can make (take-off to the "
@@ -160,7 +167,7 @@ def plan(targets_file, random_count, area_file, seed, origin, rho_m, airspeed_m_
          altitude_m, min_altitude_m, home_deg, home_altitude_amsl_m, launch_bearing_deg, landing_bearing_deg, autopilot,
          return_mode, design, max_miss_m, wind_spread_m_s, tolerance_m, max_items, algorithm, region, time_limit_s,
          fallback, outputs, format_name,
-         plot_file, connection, via, verify, signing_key_file, transfer_timeout_s, endurance_min,
+         plot_file, connection, vehicle_connection, via, verify, signing_key_file, transfer_timeout_s, endurance_min,
          photo, roi, gimbal_pitch_deg, loiter_specs, loiter_radius_m, simulate, speedup,
          vehicle_params_file, l1_period_s, wind, quiet, as_json) -> None:
     """Plan a Dubins tour through the targets and write it as a mission.
@@ -181,7 +188,15 @@ def plan(targets_file, random_count, area_file, seed, origin, rho_m, airspeed_m_
     _check_writable([*outputs, *([plot_file] if plot_file else [])], inputs)
     if algorithm in ("rbta", "auto") and region not in ("bounding", "min-area"):
         region_heading_deg(region)
-    designed_for = designed_for_file(vehicle_params_file, autopilot, l1_period_s)
+    if connection and vehicle_connection and connection != vehicle_connection:
+        raise UserError("--upload and --from-vehicle name two vehicles; the mission is designed "
+                        "for the one it is uploaded to: give one")
+    if connection or vehicle_connection:
+        (autopilot, designed_for, home_deg, home_altitude_amsl_m, wind) = _from_vehicle(
+            connection or vehicle_connection, signing_key_file, autopilot, vehicle_params_file,
+            l1_period_s, home_deg, home_altitude_amsl_m, wind)
+    else:
+        designed_for = designed_for_file(vehicle_params_file, autopilot, l1_period_s)
     rho, rho_source = turn_radius_from(rho_m, airspeed_m_s, max_bank_deg,
                                        designed_for if autopilot == "ardupilot" else None)
     targets = _targets(targets_file, random_count, area_file, seed, rho)
@@ -291,6 +306,69 @@ def plan(targets_file, random_count, area_file, seed, origin, rho_m, airspeed_m_
                              speedup, max_miss_m, max_items, wind)
             console.current().summary.setdefault("simulated", []).append(console.current().summary.pop("flight"))
     console.finish()
+
+
+def _from_vehicle(connection, signing_key_file, autopilot, vehicle_params_file, l1_period_s,
+                  home_deg, home_amsl_m, wind):
+    """What the mission is designed for, read from the vehicle before anything is designed:
+    (autopilot, navigation parameters, home, home AMSL, wind), each value read reported;
+    what the user gave explicitly (--home, --home-amsl, --wind, --l1-period) wins.
+    UserError when the vehicle does not answer or is not the autopilot asked for."""
+    from ..autopilot.navigation import Wind
+    from ..autopilot.parameters import checked_parameters
+    from ..upload import read_vehicle
+    from ..upload.connection import read_signing_key
+    key = read_signing_key(signing_key_file) if signing_key_file else None
+    try:
+        info = read_vehicle(connection, key)
+    except DtspError as error:
+        raise UserError(f"reading the vehicle before the design: {error}") from None
+    flavour = "px4" if info.autopilot == Autopilot.PX4 else "ardupilot"
+    explicit = click.get_current_context().get_parameter_source("autopilot")
+    if flavour != autopilot and explicit != click.core.ParameterSource.DEFAULT:
+        raise UserError(f"the vehicle at {connection} runs {'PX4' if flavour == 'px4' else 'ArduPilot'}, "
+                        f"not --autopilot {autopilot}: plan for the vehicle it will fly")
+    read = [f"{'PX4' if flavour == 'px4' else 'ArduPilot'}"]
+    unread = [name for name in info.asked if name not in info.parameters]
+    parameters = checked_parameters(flavour, info.parameters, f"the vehicle at {connection}")
+    if info.parameters:
+        read.append(", ".join(f"{name} {value:g}" for name, value in info.parameters.items()))
+    if unread:
+        note(f"could not read {', '.join(unread)} from the vehicle in time: designed with the "
+             "stock values")
+    if vehicle_params_file:
+        note(f"--vehicle-params {vehicle_params_file} set aside: the mission is designed for the "
+             "parameters the vehicle has")
+    if l1_period_s is not None:
+        parameters = replace(parameters, **{"NPFG_PERIOD" if flavour == "px4" else
+                                            "NAVL1_PERIOD": l1_period_s})
+    if info.home_deg is not None:
+        read.append(f"home {info.home_deg[0]:.7f},{info.home_deg[1]:.7f}"
+                    + (f" at {info.home_amsl_m:.1f} m AMSL" if info.home_amsl_m is not None else ""))
+        source = click.get_current_context().get_parameter_source("home_altitude_amsl_m")
+        if home_deg is None:
+            home_deg = info.home_deg
+            if info.home_amsl_m is not None and source == click.core.ParameterSource.DEFAULT:
+                home_amsl_m = info.home_amsl_m
+        else:
+            note("--home given: the vehicle's home is not used")
+    else:
+        note("the vehicle reported no home (no position fix yet?)")
+    if info.wind is not None:
+        speed, from_deg = info.wind
+        read.append(f"wind estimate {speed:.1f} m/s from {from_deg:.0f} deg")
+        if wind is None and speed >= 0.5:
+            wind = Wind(round(speed, 1), round(from_deg) % 360.0)
+        elif wind is None:
+            note("the vehicle's wind estimate is calm (ArduPilot estimates the wind in flight "
+                 "only): designed for calm air; give --wind from a forecast if there is wind")
+        elif wind is not None:
+            note(f"--wind {wind} given: the vehicle's estimate is not used")
+    say(f"read from the vehicle at {connection}: " + "; ".join(read))
+    record(vehicle_read={"autopilot": flavour, "parameters": info.parameters,
+                         "home_deg": info.home_deg, "home_amsl_m": info.home_amsl_m,
+                         "wind": info.wind, "not_read": unread})
+    return flavour, parameters, home_deg, home_amsl_m, wind
 
 
 def _sortie_family(output: str) -> list[Path]:

@@ -143,6 +143,29 @@ def _vehicle_type_name(value: int) -> str:
     return f"a {name}"
 
 
+def read_vehicle(connection: str, signing_key: bytes | None = None,
+                 heartbeat_timeout_s: float | None = None) -> VehicleInfo:
+    """What a vehicle says of itself before a mission is designed for it: its autopilot and
+    type (heartbeat), home (HOME_POSITION), the navigation parameters of its own autopilot
+    (ArduPlane's or PX4's names) and, from ArduPilot, its wind estimate (WIND, listened for
+    :data:`WIND_WAIT_S`).  :class:`LinkError` for a vehicle that does not answer, runs no
+    autopilot this plans for, or is no fixed wing -- before anything is designed."""
+    options = {} if heartbeat_timeout_s is None else {"heartbeat_timeout_s": heartbeat_timeout_s}
+    uploader = get_uploader("pymavlink")(connection, signing_key=signing_key, **options)
+    with uploader:
+        autopilot = uploader._autopilot
+        if autopilot not in _AUTOPILOT_NAMES:
+            raise LinkError(f"the vehicle at {connection} runs {_autopilot_name(autopilot)}: "
+                            "missions are planned for ArduPilot or PX4")
+        names = NAMES if autopilot == Autopilot.ARDUPILOTMEGA else PX4_NAMES
+        info = uploader.vehicle_info(names, WIND_WAIT_S if autopilot == Autopilot.ARDUPILOTMEGA
+                                     else 0.0, autopilot)
+    if info.vehicle_type is not None and info.vehicle_type not in FIXED_WING_TYPES:
+        raise LinkError(f"the vehicle at {connection} is {_vehicle_type_name(info.vehicle_type)} "
+                        f"(MAV_TYPE {info.vehicle_type}); missions are planned for fixed wings")
+    return info
+
+
 def _unstated_for_ardupilot(mission: VehicleMission) -> str:
     """The note for a mission file that does not say its autopilot, sent to an ArduPilot."""
     px4_only = sorted({int(i.command) for i in mission.items
@@ -321,4 +344,5 @@ def download_mission(connection: str, via: str = "pymavlink",
 
 
 __all__ = ["UPLOADER_GROUP", "UploadReport", "Uploader", "VehicleInfo", "WireItem", "download_mission",
+           "read_vehicle",
            "get_uploader", "to_wire", "upload_mission", "uploaders", "vehicle_warnings"]

@@ -44,6 +44,8 @@ class VehicleInfo:
     #: the vehicle's own wind estimate (ArduPilot's WIND: m/s, degrees it comes from), if it
     #: sent one while asked the rest
     wind: tuple[float, float] | None = None
+    #: HOME_POSITION's altitude above mean sea level, m
+    home_amsl_m: float | None = None
     #: MAV_TYPE of its heartbeat (1: fixed wing)
     vehicle_type: int | None = None
     #: the parameters asked for (those missing from ``parameters`` were not answered in time)

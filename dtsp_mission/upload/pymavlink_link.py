@@ -230,7 +230,7 @@ class PymavlinkUploader(Uploader):
             parameter_names = ()         # another autopilot's names: it would stay silent
         timer = self._timer = getattr(self, "_timer", None) or RetransmitTimer()
         values: dict[str, float] = {}
-        home = wind = None
+        home = wind = home_amsl = None
         started = time.monotonic()
         deadline = started + VEHICLE_INFO_S
         interval, rounds = 0.1, 0
@@ -260,6 +260,7 @@ class PymavlinkUploader(Uploader):
                     timer.sample(time.monotonic() - now)
                 if message.get_type() == "HOME_POSITION":
                     home = (message.latitude / 1e7, message.longitude / 1e7)
+                    home_amsl = message.altitude / 1e3
                 elif (name := parameter_name(message.param_id)) in parameter_names:
                     values[name] = float(message.param_value)
                 if home is not None and len(values) == len(parameter_names) and (
@@ -268,6 +269,7 @@ class PymavlinkUploader(Uploader):
             interval = (min(1.0, interval * 2) if not answered else
                         max(0.05, 2 * timer.timeout_s) if timer.srtt_s is not None else 0.1)
         return VehicleInfo(self._autopilot, home, values, True, wind,
+                           home_amsl if home is not None else None,
                            getattr(self, "_vehicle_type", None), tuple(parameter_names))
 
     # -- the mission protocol ------------------------------------------------------------------

@@ -294,3 +294,52 @@ def test_lost_position_reports_are_counted():
     assert lost_reports([0.0, 0.1, 0.2, 0.3], 10.0) == 0
     assert lost_reports([0.0, 0.1, 0.5, 0.6, 1.0], 10.0) == 3 + 3
     assert lost_reports([], 10.0) == 0
+
+
+def test_plan_reads_the_vehicle_first_and_designs_for_it(tmp_path, start_vehicle):
+    """--from-vehicle reads the navigation parameters, home and wind estimate of the vehicle
+    and designs for them (each value reported); --upload does the same, so the upload finds
+    nothing that differs; a vehicle that is not there is an error before any design."""
+    import json
+    from dataclasses import replace as replaced
+
+    from dtsp_mission.autopilot.navigation import Wind
+    from dtsp_mission.autopilot.parameters import ARDUPLANE_DEFAULTS
+    from dtsp_mission.mission.model import Home
+    from pathlib import Path
+    root = Path(__file__).resolve().parents[2]
+    site = tmp_path / "s8.csv"
+    site.write_text("\n".join((root / "examples" / "site-inspection.csv").read_text()
+                              .splitlines()[:9]) + "\n")
+    home = Home(46.8075, 6.9420, 612.0)
+    tuned = replaced(ARDUPLANE_DEFAULTS, NAVL1_PERIOD=17.0, WP_RADIUS=60.0)
+    vehicle = start_vehicle(VehicleMissionAt(home), parameters=tuned, wind=Wind(4.0, 250.0))
+    link = f"udpout:127.0.0.1:{vehicle.port}"
+    result = run("plan", site, "--radius", 80, "--time-limit", 1, "--from-vehicle", link,
+                 "-o", tmp_path / "v.plan", "--json")
+    assert result.exit_code == 0, result.output
+    read = json.loads(result.stdout)["vehicle_read"]
+    assert read["parameters"]["NAVL1_PERIOD"] == 17.0 and read["parameters"]["WP_RADIUS"] == 60.0
+    assert read["home_deg"] == pytest.approx([46.8075, 6.9420]) and read["home_amsl_m"] == pytest.approx(612.0)
+    assert read["wind"] == pytest.approx([4.0, 250.0], abs=0.05)
+    assert "read from the vehicle at" in result.stderr and "NAVL1_PERIOD 17" in result.stderr
+    plan = json.loads((tmp_path / "v.plan").read_text())
+    assert plan["dtspMission"]["aircraft"]["parameters"]["NAVL1_PERIOD"] == 17.0
+    assert plan["mission"]["plannedHomePosition"] == pytest.approx([46.8075, 6.9420, 612.0])
+    assert (plan["dtspMission"]["designWind"]["speed_m_s"], plan["dtspMission"]["designWind"]["from_deg"]) == (4.0, 250.0)
+    assert vehicle.uploads == 0
+    uploaded = run("plan", site, "--radius", 80, "--time-limit", 1, "--upload", link, "--json")
+    assert uploaded.exit_code == 0, uploaded.output
+    assert vehicle.uploads == 1 and "warning" not in uploaded.stderr
+    missing = run("plan", site, "--radius", 80, "--time-limit", 1, "--from-vehicle",
+                  "udpout:127.0.0.1:9", "-o", tmp_path / "x.plan")
+    assert missing.exit_code == 2 and "reading the vehicle before the design" in missing.output
+    assert "no heartbeat" in missing.output and not (tmp_path / "x.plan").exists()
+
+
+class VehicleMissionAt:
+    """What start_vehicle needs of a mission: its home and autopilot."""
+
+    def __init__(self, home):
+        from dtsp_mission.autopilot import Autopilot
+        self.home, self.autopilot = home, Autopilot.ARDUPILOTMEGA

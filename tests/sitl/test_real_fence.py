@@ -61,3 +61,27 @@ def test_the_fence_and_rally_points_reach_the_real_autopilot(tmp_path, autopilot
             for kind, sent in ((1, mission.fence), (2, mission.rally)):
                 link.mission_type = kind
                 assert other_differences(other_to_wire(sent, kind), link.download()) == []
+
+
+def test_plan_reads_the_real_arduplane_before_designing(tmp_path):
+    """``plan --from-vehicle``: the real ArduPlane's navigation parameters (a tuned L1 period)
+    and home are read and designed for, each reported."""
+    why = BINARIES.missing("ardupilot")
+    if why is not None:
+        pytest.skip(f"real ardupilot SITL not here: {why}")
+    targets = tmp_path / "t.csv"
+    targets.write_text("\n".join((ROOT / "examples" / "site-inspection.csv").read_text()
+                                 .splitlines()[:9]) + "\n")
+    settings = SitlSettings(46.8081337, 6.9433446, 700.0, instance=_instance(),
+                            parameters={"NAVL1_PERIOD": 17.0})
+    with ArduPlaneSitl(BINARIES.arduplane, settings) as sitl:
+        made = subprocess.run(CLI + ["plan", str(targets), "--radius", "80", "--time-limit", "1",
+                                     "--from-vehicle", sitl.connection, "--json",
+                                     "-o", str(tmp_path / "v.plan")],
+                              capture_output=True, text=True, timeout=240)
+    assert made.returncode == 0, made.stderr
+    read = json.loads(made.stdout)["vehicle_read"]
+    assert read["autopilot"] == "ardupilot" and read["parameters"]["NAVL1_PERIOD"] == 17.0
+    plan = json.loads((tmp_path / "v.plan").read_text())
+    assert plan["dtspMission"]["aircraft"]["parameters"]["NAVL1_PERIOD"] == 17.0
+    assert plan["mission"]["plannedHomePosition"][2] == pytest.approx(700.0, abs=1.0)
