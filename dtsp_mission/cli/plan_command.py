@@ -20,6 +20,7 @@ from ..pipeline import PlanRequest, PlanResult, check_request, run_plan
 from ..planning import planners
 from ..planning.base import MERGE_RESOLUTION_RHO
 from ..planning.rbta import region_heading_deg
+from ..map import require_bokeh
 from ..plot import plot_format, render_plan, require_matplotlib
 from ..targets import GeoTargets, Targets, random_targets, read_targets
 from ..targets.model import target_name
@@ -127,6 +128,11 @@ def _duration(seconds: float) -> str:
               help="Write here; the format follows the extension (.plan, .waypoints, .geojson, "
                    ".json tour) unless --format says. Repeatable.")
 @click.option("--format", "format_name", help="Output format for every -o, whatever its extension.")
+@click.option("--map", "map_file", type=click.Path(dir_okay=False), metavar="FILE.html",
+              help="An interactive map of the mission, one self-contained HTML file: targets "
+                   "coloured by the predicted miss, the planned path, the mission items in order, "
+                   "take-off, the return, the survey area and a geofence (-o *.fence.plan); "
+                   "base map from public tile servers when online, the overlay offline too.")
 @click.option("--plot", "plot_file", type=click.Path(dir_okay=False), metavar="FILE",
               help="Draw targets, path and waypoints to this picture (.png, .svg, .pdf, .jpg).")
 @click.option("--upload", "connection", metavar="CONNECTION",
@@ -167,7 +173,7 @@ def plan(targets_file, random_count, area_file, seed, origin, rho_m, airspeed_m_
          altitude_m, min_altitude_m, home_deg, home_altitude_amsl_m, launch_bearing_deg, landing_bearing_deg, autopilot,
          return_mode, design, max_miss_m, wind_spread_m_s, tolerance_m, max_items, algorithm, region, time_limit_s,
          fallback, outputs, format_name,
-         plot_file, connection, vehicle_connection, via, verify, signing_key_file, transfer_timeout_s, endurance_min,
+         map_file, plot_file, connection, vehicle_connection, via, verify, signing_key_file, transfer_timeout_s, endurance_min,
          photo, roi, gimbal_pitch_deg, loiter_specs, loiter_radius_m, simulate, speedup,
          vehicle_params_file, l1_period_s, wind, quiet, as_json) -> None:
     """Plan a Dubins tour through the targets and write it as a mission.
@@ -185,7 +191,12 @@ def plan(targets_file, random_count, area_file, seed, origin, rho_m, airspeed_m_
         require_matplotlib()
         plot_format(plot_file)
     inputs = (targets_file, area_file, vehicle_params_file, signing_key_file)
-    _check_writable([*outputs, *([plot_file] if plot_file else [])], inputs)
+    if map_file:
+        require_bokeh()
+        if Path(map_file).suffix.lower() not in (".html", ".htm"):
+            raise UserError(f"--map {map_file}: the map is an HTML page; name it .html")
+    _check_writable([*outputs, *([plot_file] if plot_file else []),
+                     *([map_file] if map_file else [])], inputs)
     if algorithm in ("rbta", "auto") and region not in ("bounding", "min-area"):
         region_heading_deg(region)
     if connection and vehicle_connection and connection != vehicle_connection:
@@ -206,7 +217,8 @@ def plan(targets_file, random_count, area_file, seed, origin, rho_m, airspeed_m_
              "loiter_turns)")
     if loiter_specs:
         targets = with_loiters(targets, loiter_specs)
-    needs_mission = any(writer.needs_mission for _, writer in writers) or connection or simulate
+    needs_mission = (any(writer.needs_mission for _, writer in writers) or connection or simulate
+                     or map_file)
     # Targets on the earth get a mission (a tour-only output checks its storage); local x/y
     # without --origin get the tour only, unless a mission is asked for (then refused).
     settings = None
@@ -275,6 +287,12 @@ def plan(targets_file, random_count, area_file, seed, origin, rho_m, airspeed_m_
         _check_writable([path for path, _, _ in rendered], inputs)
     stale = _stale_sorties([(output, writer) for output, writer in writers if writer.needs_mission],
                            {str(path): content for path, _, content in rendered})
+    if map_file:
+        from ..map import render_map
+        fences = [fence for _, writer in writers if hasattr(writer, "geofence_deg")
+                  for fence in writer.geofence_deg(product)]
+        area = result.geodetic.area_deg if result.geodetic is not None else None
+        rendered.append((map_file, "map", render_map(product, max_miss_m, area, fences)))
     if plot_file:
         rendered.append((plot_file, "plot", render_plan(product, plot_format(plot_file),
                                                          result.area_m)))
@@ -288,8 +306,8 @@ def plan(targets_file, random_count, area_file, seed, origin, rho_m, airspeed_m_
                    remove=stale)
     for output, description, _ in rendered:
         say(f"wrote {output} ({description})")
-        if description == "plot":
-            record(plot=str(output))
+        if description in ("plot", "map"):
+            record(**{description: str(output)})
         else:
             console.current().summary.setdefault("files", []).append(str(output))
     for path in sorted(stale):

@@ -60,6 +60,12 @@ class FencedPlanExporter(QGCPlanExporter):
     extensions = (".fence.plan",)
     description = "QGroundControl .plan file with geofence and rally point"
 
+    def geofence_deg(self, mission: Mission) -> list[tuple[bool, np.ndarray]]:
+        """The geofence polygons this writes: (inclusion, rows of latitude, longitude) -- for
+        a map of the mission."""
+        latitudes, longitudes = mission.frame.to_geodetic(fence_polygon_local(mission))
+        return [(True, np.column_stack([latitudes, longitudes]))]
+
     def document(self, mission: Mission) -> dict[str, Any]:
         data = super().document(mission)
         latitudes, longitudes = mission.frame.to_geodetic(fence_polygon_local(mission))
