@@ -47,7 +47,7 @@ OPTIONS = {
     "airspeed_m_s": "--airspeed", "autopilot": "--autopilot", "origin": "--origin",
     "signing_key": "--signing-key", "via": "--via", "verify=False": "--no-verify",
     "count": "--random", "format_name": "--format", "design": "--design",
-    "landing_bearing_deg": "--landing-bearing", "home_deg": "--home", "launch_bearing_deg": "--launch-bearing",
+    "landing_bearing_deg": "--landing-bearing", "home_deg": "--home", "area": "--area", "launch_bearing_deg": "--launch-bearing",
 }
 
 

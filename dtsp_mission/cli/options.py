@@ -61,8 +61,9 @@ class Quantity(click.ParamType):
 
     def describe(self) -> str:
         shown = (lambda v: f"{v:,}") if self.integer else (lambda v: f"{v:g}")
-        low = f"above {shown(self.low)}" if self.low_open else f"from {shown(self.low)}"
-        text = f"{low} to {shown(self.high)}{' ' + self.unit if self.unit else ''}"
+        unit = f" {self.unit}" if self.unit else ""
+        text = (f"above {shown(self.low)} and at most {shown(self.high)}{unit}" if self.low_open
+                else f"from {shown(self.low)} to {shown(self.high)}{unit}")
         return f"0 ({self.zero}) or {text}" if self.zero else text
 
     def convert(self, value, param, ctx):

@@ -29,6 +29,6 @@ def read_targets(path: str | os.PathLike) -> GeoTargets | Targets:
         targets = READERS[suffix](path)
     if len(targets) == 0:
         raise FileFormatError(f"{path}: no point targets, only a survey area (a Polygon): give "
-                              "Point features, or draw targets in the area with --random N "
-                              "--area " + str(path))
+                              "Point features, or draw targets in the area (`count` N with "
+                              f"`area` {path})")
     return targets

@@ -25,7 +25,7 @@ def test_dubins_command_prints_the_exact_path():
 def test_dubins_command_rejects_bad_radius_with_exit_2():
     result = run("dubins", "0,0,0", "10,0,0", "--radius", "0")
     assert result.returncode == 2
-    assert "turn radius must be a positive number" in result.stderr
+    assert "--radius" in result.stderr and "from 0.1 to 20000 m" in result.stderr
 
 
 def test_check_command_on_valid_and_broken_tours(tmp_path, rng):

@@ -71,9 +71,9 @@ BAD_INPUTS = [
     ("targets.csv", "lat,lon\n47,8\n47,181\n", [], "line 3: lon 181 is not a number between"),
     ("targets.csv", "lat,lon\n40,8\n44,8\n", [], "too large an area for one flat mission frame"),
     ("targets.csv", "lat,lon,alt\n47,8,50\n47.01,8,-5\n", [], "altitude -5.0 m must be a number above 0"),
-    ("targets.csv", "lat,lon\n47,8\n47.01,8\n", ["--alt", "-10"], "altitude must be a number above 0"),
-    ("targets.csv", "lat,lon\n47,8\n47.01,8\n", ["--radius", "0"], "turn radius must be a positive number"),
-    ("targets.csv", "lat,lon\n47,8\n47.01,8\n", ["--radius", "nan"], "turn radius must be a positive number"),
+    ("targets.csv", "lat,lon\n47,8\n47.01,8\n", ["--alt", "-10"], "above 0 and at most 10000 m"),
+    ("targets.csv", "lat,lon\n47,8\n47.01,8\n", ["--radius", "0"], "from 0.1 to 20000 m"),
+    ("targets.csv", "lat,lon\n47,8\n47.01,8\n", ["--radius", "nan"], "from 0.1 to 20000 m"),
     ("targets.csv", "x,y\n0,0\n900,0\n", [], "give --origin LAT,LON"),
     ("targets.geojson", "{not json", [], "not valid JSON"),
     ("targets.geojson", '{"type": "FeatureCollection", "features": []}', [], "no Point features"),
@@ -103,7 +103,7 @@ def test_bad_input_gives_a_clear_message_exit_2_and_leaves_outputs_alone(tmp_pat
 
 def test_bad_radius_and_missing_file(tmp_path):
     result = run(str(EXAMPLE), "--radius", "-5")
-    assert result.returncode == 2 and "turn radius must be a positive number" in result.stderr
+    assert result.returncode == 2 and "from 0.1 to 20000 m" in result.stderr
     result = run(str(tmp_path / "nope.csv"), "--radius", "80")
     assert result.returncode == 2 and "no such file" in result.stderr
 
