@@ -150,7 +150,9 @@ def other_differences(planned: list[WireItem], on_vehicle: list[WireItem],
         changed = [name for name in ("command", "x", "y") if getattr(sent, name) != getattr(held, name)]
         changed += [f"param{k}" for k in (1, 2) if abs(getattr(sent, f"param{k}")
                                                      - getattr(held, f"param{k}")) > 1e-3]
-        if sent.command == RALLY_POINT_COMMAND or sent.command == 5000:
+        # a return point keeps its position only (ArduPilot stores no altitude for it, its
+        # FENCE_RET_ALT decides; PX4 gives it back in another frame)
+        if sent.command == RALLY_POINT_COMMAND:
             if abs(sent.z - held.z) > 1.0:
                 changed.append("z")
             if _SAME_FRAME.get(sent.frame, sent.frame) != _SAME_FRAME.get(held.frame, held.frame):

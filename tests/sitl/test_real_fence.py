@@ -43,7 +43,19 @@ def test_the_fence_and_rally_points_reach_the_real_autopilot(tmp_path, autopilot
                                  "--autopilot", autopilot, "-q", "-o", str(plan)],
                           capture_output=True, text=True, timeout=240)
     assert made.returncode == 0, made.stderr
+    # beside the plugin's inclusion polygon: every other kind QGroundControl writes
+    document = json.loads(plan.read_text())
+    lat, lon, _ = document["mission"]["plannedHomePosition"]
+    document["geoFence"]["polygons"].append({"inclusion": False, "version": 1, "polygon": [
+        [lat + 0.002, lon + 0.002], [lat + 0.003, lon + 0.002], [lat + 0.003, lon + 0.003]]})
+    document["geoFence"]["circles"] += [
+        {"circle": {"center": [lat - 0.002, lon - 0.002], "radius": 60.0}, "inclusion": False,
+         "version": 1},
+        {"circle": {"center": [lat, lon], "radius": 3000.0}, "inclusion": True, "version": 1}]
+    document["geoFence"]["breachReturn"] = [lat + 0.001, lon, 120.0]
+    plan.write_text(json.dumps(document))
     mission = read_mission(plan)
+    assert {int(i.command) for i in mission.fence} == {5000, 5001, 5002, 5003, 5004}
     settings = SitlSettings(mission.home.latitude_deg, mission.home.longitude_deg,
                             mission.home.altitude_amsl_m, instance=_instance())
     px4 = autopilot == "px4"
