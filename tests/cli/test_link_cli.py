@@ -343,3 +343,27 @@ class VehicleMissionAt:
     def __init__(self, home):
         from dtsp_mission.autopilot import Autopilot
         self.home, self.autopilot = home, Autopilot.ARDUPILOTMEGA
+
+
+def test_ctrl_c_during_an_upload_says_what_the_vehicle_may_hold(tmp_path, start_vehicle):
+    """SIGINT while the items go out (a slow link: every datagram delayed): exit 130 and what
+    an ArduPilot holds then, not click's bare "Aborted!"."""
+    import signal
+
+    from dtsp_mission.sim.fault_proxy import Faults, FaultProxy
+    big = make_mission(60, 8, 80.0, span_m=3000.0, airspeed_m_s=20.0)
+    path = tmp_path / "big.plan"
+    exporter_for(path).write(big, path)
+    vehicle = start_vehicle(big)
+    with FaultProxy(("127.0.0.1", vehicle.port), Faults(delay_s=0.08, seed=1)) as proxy:
+        process = subprocess.Popen([sys.executable, "-m", "dtsp_mission.cli", "upload", str(path),
+                                    "--connect", f"udpout:127.0.0.1:{proxy.port}"],
+                                   stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True)
+        deadline = time.monotonic() + 60
+        while vehicle.server.counts["requests_sent"] < 5 and time.monotonic() < deadline:
+            time.sleep(0.05)
+        process.send_signal(signal.SIGINT)
+        out, err = process.communicate(timeout=60)
+    assert process.returncode == 130, (out, err)
+    assert "Traceback" not in err and "Aborted!" not in err
+    assert re.search(r"interrupted after \d+ of \d+ items were sent: ArduPilot writes items", err), err
