@@ -102,11 +102,11 @@ def test_a_heading_of_1e300_degrees_ends_at_the_goal():
 
 
 def test_plan_designs_for_its_l1_period(site, tmp_path):
-    result = run("plan", site / "s8.csv", *QUICK, "--l1-period", 25, "--json",
+    result = run("plan", site / "s8.csv", *QUICK, "--l1-period", 17, "--json",
                  "-o", tmp_path / "p.plan")
     assert result.returncode == 0, result.stderr
     designed = json.loads((tmp_path / "p.plan").read_text())["dtspMission"]["aircraft"]
-    assert designed["parameters"]["NAVL1_PERIOD"] == 25
+    assert designed["parameters"]["NAVL1_PERIOD"] == 17
 
 
 @pytest.mark.parametrize("extra,words", [
@@ -242,14 +242,15 @@ def test_an_output_that_is_an_input_is_refused(site, tmp_path):
 
 
 def test_sorties_never_replace_an_unrelated_file_and_never_leave_stale_ones(site, tmp_path):
+    fast = ("--radius", 80, "--time-limit", 0)
     (tmp_path / "q-2.plan").write_text("keep\n")
-    refused(run("plan", site / "s8.csv", *QUICK, "--max-items", 7, "-o", tmp_path / "q.plan"),
+    refused(run("plan", site / "s8.csv", *fast, "--max-items", 7, "-o", tmp_path / "q.plan"),
             "q-2.plan exists and is not a sortie file dtsp-mission wrote")
     assert (tmp_path / "q-2.plan").read_text() == "keep\n" and not (tmp_path / "q-1.plan").exists()
-    split = run("plan", site / "s8.csv", *QUICK, "--max-items", 7, "-o", tmp_path / "z.plan")
+    split = run("plan", site / "s8.csv", *fast, "--max-items", 7, "-o", tmp_path / "z.plan")
     assert split.returncode == 0, split.stderr
     assert (tmp_path / "z-1.plan").exists() and (tmp_path / "z-2.plan").exists()
-    whole = run("plan", site / "s8.csv", *QUICK, "-o", tmp_path / "z.plan")
+    whole = run("plan", site / "s8.csv", *fast, "-o", tmp_path / "z.plan")
     assert whole.returncode == 0, whole.stderr
     assert sorted(p.name for p in tmp_path.glob("z*")) == ["z.plan"]
     assert "removed" in whole.stdout + whole.stderr
