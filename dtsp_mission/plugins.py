@@ -70,6 +70,25 @@ def load_group(group: str, accepts: Callable[[object], bool],
     return found
 
 
+def load_one(group: str, name: str, accepts: Callable[[object], bool],
+             expected: str) -> object | Exception | None:
+    """The entry point ``name`` of ``group``, loaded alone (a built-in before a plugin of
+    that name, as :func:`load_group` decides); its error if it is broken; None if there is
+    none.  A command line loads only the command it runs."""
+    for entry_point in _in_order(group):
+        if entry_point.name != name:
+            continue
+        try:
+            loaded = entry_point.load()
+            if not accepts(loaded):
+                raise TypeError(f"{entry_point.value} is not {expected}")
+            return loaded
+        except Exception as error:  # a broken plugin must not break the program
+            log.warning("%s plugin %r is broken: %r", group, entry_point.name, error)
+            return error
+    return None
+
+
 def origins(group: str) -> dict[str, str]:
     """For each entry point of ``group``, the distribution that provides it ("name version"),
     without loading anything."""
