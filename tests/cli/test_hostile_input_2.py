@@ -131,30 +131,8 @@ def test_a_loiter_name_shared_by_several_targets_is_refused(tmp_path):
 
 # -- readers take what QGroundControl and GIS tools write -------------------------------------
 
-QGC_PLAN = {
-    "fileType": "Plan", "groundStation": "QGroundControl", "version": 1,
-    "geoFence": {"circles": [], "polygons": [], "version": 2},
-    "rallyPoints": {"points": [], "version": 2},
-    "mission": {
-        "cruiseSpeed": 15, "firmwareType": 12, "globalPlanAltitudeMode": 1, "hoverSpeed": 5,
-        "plannedHomePosition": [47.3977507, 8.5456074, 487.9], "vehicleType": 1, "version": 2,
-        "items": [
-            {"AMSLAltAboveTerrain": None, "Altitude": 50, "AltitudeMode": 1, "autoContinue": True,
-             "command": 22, "doJumpId": 1, "frame": 3,
-             "params": [15, 0, 0, None, 47.3977507, 8.5456074, 50], "type": "SimpleItem"},
-            {"AMSLAltAboveTerrain": None, "Altitude": 50, "AltitudeMode": 1, "autoContinue": True,
-             "command": 16, "doJumpId": 2, "frame": 3,
-             "params": [0, 0, 0, None, 47.3999019, 8.5458096, 50], "type": "SimpleItem"},
-            {"AMSLAltAboveTerrain": 537.9, "Altitude": 50, "AltitudeMode": 3, "autoContinue": True,
-             "command": 16, "doJumpId": 3, "frame": 0,
-             "params": [0, 0, 0, None, 47.3999917, 8.5502736, 537.9], "type": "SimpleItem"},
-            {"autoContinue": True, "command": 20, "doJumpId": 4, "frame": 2,
-             "params": [0, 0, 0, 0, 0, 0, 0], "type": "SimpleItem"}]}}
-
-
-def test_a_plan_as_qgroundcontrol_writes_it_is_flown(tmp_path):
-    (tmp_path / "qgc.plan").write_text(json.dumps(QGC_PLAN, indent=4))
-    result = run("fly", tmp_path / "qgc.plan", "--speedup", 400, "--json")
+def test_a_plan_as_qgroundcontrol_writes_it_is_flown():
+    result = run("fly", ROOT / "tests" / "data" / "qgroundcontrol-4.plan", "--speedup", 400, "--json")
     assert result.returncode == 0, result.stderr
     assert json.loads(result.stdout)["flight"]["completed"] is True
 

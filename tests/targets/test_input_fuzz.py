@@ -169,30 +169,10 @@ def test_a_mutated_waypoints_file_is_read_or_refused(tmp_path, data):
     _read_or_refuse(read_mission, path)
 
 
-#: A .plan as QGroundControl (4.x) saves it: every simple item with AltitudeMode, Altitude and
-#: AMSLAltAboveTerrain (null but in the terrain mode), a yaw of null, a terrain-mode item in
-#: frame GLOBAL (AMSL) beside relative ones.
-QGC_PLAN = {
-    "fileType": "Plan", "groundStation": "QGroundControl", "version": 1,
-    "geoFence": {"circles": [], "polygons": [], "version": 2},
-    "rallyPoints": {"points": [], "version": 2},
-    "mission": {
-        "cruiseSpeed": 15, "firmwareType": 12, "globalPlanAltitudeMode": 1, "hoverSpeed": 5,
-        "plannedHomePosition": [47.3977507, 8.5456074, 487.9], "vehicleType": 1, "version": 2,
-        "items": [
-            {"AMSLAltAboveTerrain": None, "Altitude": 50, "AltitudeMode": 1, "autoContinue": True,
-             "command": 22, "doJumpId": 1, "frame": 3,
-             "params": [15, 0, 0, None, 47.3977507, 8.5456074, 50], "type": "SimpleItem"},
-            {"AMSLAltAboveTerrain": None, "Altitude": 50, "AltitudeMode": 1, "autoContinue": True,
-             "command": 16, "doJumpId": 2, "frame": 3,
-             "params": [0, 0, 0, None, 47.3999019, 8.5458096, 50], "type": "SimpleItem"},
-            {"AMSLAltAboveTerrain": 537.9, "Altitude": 50, "AltitudeMode": 3, "autoContinue": True,
-             "command": 16, "doJumpId": 3, "frame": 0,
-             "params": [0, 0, 0, None, 47.3999917, 8.5502736, 537.9], "type": "SimpleItem"},
-            {"autoContinue": True, "command": 178, "doJumpId": 4, "frame": 2,
-             "params": [1, 18, -1, 0, 0, 0, 0], "type": "SimpleItem"},
-            {"autoContinue": True, "command": 20, "doJumpId": 5, "frame": 2,
-             "params": [0, 0, 0, 0, 0, 0, 0], "type": "SimpleItem"}]}}
+#: A .plan as QGroundControl (4.x) saves it (tests/data/qgroundcontrol-4.plan): every simple item
+#: with AltitudeMode, Altitude and AMSLAltAboveTerrain (null but in the terrain mode), a yaw of
+#: null, a terrain-mode item in frame GLOBAL (AMSL) beside relative ones.
+QGC_PLAN = json.loads((ROOT / "tests" / "data" / "qgroundcontrol-4.plan").read_text())
 
 
 def test_a_plan_as_qgroundcontrol_saves_it_is_read(tmp_path):
