@@ -8,6 +8,7 @@ rounds them with :func:`degrees_to_e7` -- in one place.
 
 from __future__ import annotations
 
+import functools
 from dataclasses import dataclass
 from typing import Any
 
@@ -86,6 +87,7 @@ MAX_ALTITUDE_ABOVE_HOME_M = 10_000.0
 _DOWN_TO_GROUND = {int(Command.NAV_LAND), 85}     # NAV_LAND, NAV_VTOL_LAND
 
 
+@functools.lru_cache(maxsize=1)
 def known_commands() -> frozenset[int]:
     """Every MAV_CMD the MAVLink dialects of ArduPilot and PX4 define (pymavlink's
     ardupilotmega, which includes common): a command outside it no autopilot knows."""
@@ -94,10 +96,15 @@ def known_commands() -> frozenset[int]:
                      if not ardupilotmega.enums["MAV_CMD"][value].name.endswith("ENUM_END"))
 
 
-def _reach_m(home: "Home", item: "MissionItem") -> float:
+@functools.lru_cache(maxsize=1)
+def _geod():
     from pyproj import Geod
-    _, _, distance = Geod(ellps="WGS84").inv(home.longitude_deg, home.latitude_deg,
-                                             item.longitude_deg, item.latitude_deg)
+    return Geod(ellps="WGS84")
+
+
+def _reach_m(home: "Home", item: "MissionItem") -> float:
+    _, _, distance = _geod().inv(home.longitude_deg, home.latitude_deg,
+                                 item.longitude_deg, item.latitude_deg)
     return float(distance)
 
 
@@ -172,10 +179,10 @@ class VehicleMission:
                              f"{self.home.altitude_amsl_m - item.altitude_m:g} m below home "
                              f"({self.home.altitude_amsl_m:g} m): below the ground the aircraft "
                              "took off from")
-            elif _reach_m(self.home, item) > MAX_REACH_M:
+            elif (reach := _reach_m(self.home, item)) > MAX_REACH_M:
                 found.append(f"item {number} (command {int(item.command)}) at "
                              f"({item.latitude_deg:.6f}, {item.longitude_deg:.6f}) is "
-                             f"{_reach_m(self.home, item) / 1000:,.0f} km from home: not part of a "
+                             f"{reach / 1000:,.0f} km from home: not part of a "
                              f"mission flown from there (at most {MAX_REACH_M / 1000:.0f} km)")
             if _is_nav(item) and self.height_above_home_m(item) > MAX_ALTITUDE_ABOVE_HOME_M:
                 found.append(f"item {number} (command {int(item.command)}) is "
