@@ -49,7 +49,8 @@ CODES = {"3177ef3": "3177ef3, before the real flights (the baseline)",
          "e2921f1e": "e7c4192: the model flies faster in banks, turns at 0.70",
          "9312f3f9": "c3dab92: and the first target beyond the climb-out",
          "d5ab8b13": "2f7befd: the same (a refactor)",
-         "177eeaba": "062c66f: and the design judged with the turn rate 4 % either way"}
+         "177eeaba": "062c66f: and the design judged with the turn rate 4 % either way",
+         "1d43758e": "0d85978: the same design (hostile-input checks, fence upload, map)"}
 CSV_CASES = ROOT / "docs" / "real-flights.csv"
 CSV_TARGETS = ROOT / "docs" / "real-flights-targets.csv"
 RHO_M, ALTITUDE_M = 80.0, 120.0
