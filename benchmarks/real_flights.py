@@ -50,7 +50,12 @@ CODES = {"3177ef3": "3177ef3, before the real flights (the baseline)",
          "9312f3f9": "c3dab92: and the first target beyond the climb-out",
          "d5ab8b13": "2f7befd: the same (a refactor)",
          "177eeaba": "062c66f: and the design judged with the turn rate 4 % either way",
-         "1d43758e": "0d85978: the same design (hostile-input checks, fence upload, map)"}
+         "1d43758e": "0d85978: the same design (hostile-input checks, fence upload, map)",
+         "36df6a15": "87c805a + the design judged also with the aircraft rolling slower and "
+                     "turning 6 % either way (a step, not committed)",
+         "42075cb5": "and slow zones (DO_CHANGE_SPEED) before second passes (a step, not committed)",
+         "b559873e": "and those flights held 0.5 m within the limit, slow zones also for targets "
+                     "held by less than 0.5 m, no wider tours (the commit after 87c805a)"}
 CSV_CASES = ROOT / "docs" / "real-flights.csv"
 CSV_TARGETS = ROOT / "docs" / "real-flights-targets.csv"
 RHO_M, ALTITUDE_M = 80.0, 120.0

@@ -59,7 +59,8 @@ S_SPEED_TARGET = 26                                 # the airspeed the autopilot
 S_COS_HEADING, S_SIN_HEADING = 27, 28               # cos and sin of S_HEADING, kept with it
 S_TKO_EXCESS, S_TKO_END = 29, 30                    # airspeed over the target left by the climb-out,
                                                     # and when the take-off ended
-STATE_SIZE = 31
+S_SPEED_HELD = 31                                   # the airspeed demand on its way to the target
+STATE_SIZE = 32
 
 # -- the airframe vector -----------------------------------------------------------------------
 (A_AIRSPEED, A_L1_PERIOD, A_WP_RADIUS, A_ROLL_W, A_ROLL_Z, A_L1_DAMPING,
@@ -81,7 +82,10 @@ A_TKO_END_RATIO, A_TKO_END_HOLD, A_TKO_END_DECAY = 26, 27, 28
 # ArduPlane SITL's airspeed in a bank: above the target by this much per unit of (1 / cos(bank)
 # - 1), the load factor's excess (m/s; 0: none).
 A_BANK_SPEED = 29
-AIRFRAME_SIZE = 30
+# ArduPlane's TECS: how fast its airspeed demand moves to a new target (m/s^2 up and down; 0:
+# at once).  Only where the airspeed follows a change at once (A_SPEED_TC 0).
+A_SPEED_UP, A_SPEED_DOWN = 30, 31
+AIRFRAME_SIZE = 32
 
 LOITER_EXIT_HEADING_RAD = math.radians(10.0)
 TWO_PI = 2.0 * math.pi
@@ -390,8 +394,9 @@ def _skip_instant_items(st, af, command, params, reached, counts):
             st[S_SPEED_TARGET] = params[i, 1] * af[A_SPEED_RATIO]
             if af[A_MAX_SPEED] > 0.0:
                 st[S_SPEED_TARGET] = min(st[S_SPEED_TARGET], af[A_MAX_SPEED])
-            if af[A_SPEED_TC] <= 0.0:
+            if af[A_SPEED_TC] <= 0.0 and af[A_SPEED_UP] <= 0.0 and af[A_SPEED_DOWN] <= 0.0:
                 st[S_AIRSPEED] = st[S_SPEED_TARGET]
+                st[S_SPEED_HELD] = st[S_SPEED_TARGET]
         _record_reached(reached, counts, i, st[S_TIME])
         i += 1
     st[S_INDEX] = i
@@ -525,6 +530,7 @@ def _step_takeoff(st, af, command, position, params, reached, counts, dt):
                 st[S_TKO_EXCESS] = (af[A_TKO_END_RATIO] - 1.0) * af[A_AIRSPEED]
                 st[S_TKO_END] = st[S_TIME]
         st[S_SPEED_TARGET] = af[A_AIRSPEED]
+        st[S_SPEED_HELD] = af[A_AIRSPEED]
         _complete(st, af, command, position, params, reached, counts, 0.0, 0.0, 0.0, False)
 
 
@@ -553,7 +559,14 @@ def step(st, af, command, position, params, following, reached, counts, dt):
         return
     if af[A_SPEED_TC] > 0.0:
         st[S_AIRSPEED] += (st[S_SPEED_TARGET] - st[S_AIRSPEED]) * min(dt / af[A_SPEED_TC], 1.0)
-    elif st[S_TKO_EXCESS] > 0.0 or af[A_BANK_SPEED] > 0.0:
+    elif (st[S_TKO_EXCESS] > 0.0 or af[A_BANK_SPEED] > 0.0
+          or st[S_SPEED_HELD] != st[S_SPEED_TARGET]):
+        held, target = st[S_SPEED_HELD], st[S_SPEED_TARGET]
+        if target > held:
+            held = min(target, held + af[A_SPEED_UP] * dt) if af[A_SPEED_UP] > 0.0 else target
+        elif target < held:
+            held = max(target, held - af[A_SPEED_DOWN] * dt) if af[A_SPEED_DOWN] > 0.0 else target
+        st[S_SPEED_HELD] = held
         excess = 0.0
         if st[S_TKO_EXCESS] > 0.0:        # the climb-out's airspeed bled off to the target
             bled = af[A_TKO_END_DECAY] * max(st[S_TIME] - st[S_TKO_END] - af[A_TKO_END_HOLD], 0.0)
@@ -563,7 +576,7 @@ def step(st, af, command, position, params, following, reached, counts, dt):
                 excess = 0.0
         # faster in a bank (the load factor's excess), slower again as it levels
         excess += af[A_BANK_SPEED] * (1.0 / math.cos(st[S_BANK]) - 1.0)
-        st[S_AIRSPEED] = st[S_SPEED_TARGET] + excess
+        st[S_AIRSPEED] = held + excess
     if c == NAV_LOITER_TURNS or c == NAV_LOITER_TIME:
         _step_loiter(st, af, command, position, params, following, reached, counts, dt)
         return
@@ -774,6 +787,7 @@ def new_state(heading_rad: float, airspeed_m_s: float, first_index: int) -> np.n
     st[S_COS_HEADING], st[S_SIN_HEADING] = math.cos(heading_rad), math.sin(heading_rad)
     st[S_AIRSPEED] = airspeed_m_s
     st[S_SPEED_TARGET] = airspeed_m_s
+    st[S_SPEED_HELD] = airspeed_m_s
     st[S_INDEX] = first_index
     st[S_MEASURE_START] = math.nan
     st[S_LAST_WAYPOINT_UPDATE] = -math.inf

@@ -141,6 +141,13 @@ class Airframe:
     #: stock plane; 0: the same airspeed at any bank).  Only where the airspeed follows a
     #: change at once (``airspeed_time_constant_s`` 0).
     bank_airspeed_gain_m_s: float = BANK_AIRSPEED_GAIN_M_S
+    #: How fast the airspeed moves to a new one asked for (DO_CHANGE_SPEED), m/s^2, faster
+    #: and slower (0: at once): ArduPlane's TECS moves its airspeed demand at most this fast
+    #: (slowing down: half the sink rate TECS_SINK_MIN's energy rate).  Measured in ArduPlane
+    #: SITL's stock plane at 120 m: 22 -> 16 m/s in 15 s, 16 -> 22 m/s in 7.5 s.  Only where the
+    #: airspeed follows a change at once (``airspeed_time_constant_s`` 0).
+    airspeed_up_m_s2: float = 0.8
+    airspeed_down_m_s2: float = 0.4
 
     @classmethod
     def from_parameters(cls, parameters: VehicleParameters = ARDUPLANE_DEFAULTS,
@@ -423,6 +430,8 @@ def airframe_vector(airframe: Airframe, wind: Wind = CALM) -> np.ndarray:
     v[K.A_TKO_END_HOLD] = airframe.takeoff_end_hold_s
     v[K.A_TKO_END_DECAY] = airframe.takeoff_end_decay_m_s2
     v[K.A_BANK_SPEED] = airframe.bank_airspeed_gain_m_s
+    v[K.A_SPEED_UP] = airframe.airspeed_up_m_s2
+    v[K.A_SPEED_DOWN] = airframe.airspeed_down_m_s2
     return v
 
 

@@ -32,8 +32,14 @@ def mission_items(path: FlightPath, chosen: np.ndarray, frame: LocalFrame, targe
     if settings.airspeed_m_s is not None:
         items.append(MissionItem(Command.DO_CHANGE_SPEED, Frame.MISSION,
                                  (0.0, float(settings.airspeed_m_s), -1.0, 0.0), role="speed"))
+    speeds = None if design is None else design.speed_before_m_s
     for k in range(1, len(chosen)):
         s = float(chosen[k])
+        if speeds is not None and np.isfinite(speeds[k]):
+            # a slow zone of the guidance design (or its end): ArduPilot and PX4 both act on
+            # DO_CHANGE_SPEED as it becomes current, after the waypoint before it
+            items.append(MissionItem(Command.DO_CHANGE_SPEED, Frame.MISSION,
+                                     (0.0, float(speeds[k]), -1.0, 0.0), role="speed"))
         if design is not None and k in target_at:
             index = target_at[k]
             items.append(waypoint(latitudes[k], longitudes[k], altitudes[k], "target", index,

@@ -35,12 +35,19 @@ class Tour:
     planner: str = ""
     parameters: dict[str, Any] = field(default_factory=dict)
     report: dict[str, Any] = field(default_factory=dict)   # what the planner measured
+    #: Per target, the straight the tour guarantees just before its visit (metres; None: no
+    #: such guarantee), as :func:`dtsp_mission.planning.lead_ins.with_lead_ins` plans them.
+    lead_in_m: np.ndarray | None = None
 
     def __post_init__(self) -> None:
         object.__setattr__(self, "targets_m", np.asarray(self.targets_m, dtype=float).reshape(-1, 2))
         object.__setattr__(self, "visit_s_m", np.asarray(self.visit_s_m, dtype=float).reshape(-1))
         if len(self.targets_m) != len(self.visit_s_m):
             raise ValueError("one visit arc length per target is required")
+        if self.lead_in_m is not None:
+            object.__setattr__(self, "lead_in_m", np.asarray(self.lead_in_m, dtype=float).reshape(-1))
+            if len(self.lead_in_m) != len(self.targets_m):
+                raise ValueError("one lead-in length per target is required")
 
     @property
     def length_m(self) -> float:

@@ -54,10 +54,17 @@ def item(command, params, frame=2):
             "autoContinue": True, "doJumpId": 99}
 
 
+def nth_waypoint(document, k: int = 1) -> dict:
+    """The k-th NAV_WAYPOINT item of a .plan document (0: the first; the design may put
+    DO_CHANGE_SPEED items of slow zones among them)."""
+    return [i for i in document["mission"]["items"] if i.get("command") == 16][k]
+
+
 def at_waypoint(document, command, first_param, altitude=100.0):
     items = document["mission"]["items"]
-    lat, lon = items[3]["params"][4:6]
-    items.insert(5, item(command, [first_param, 0, 0, 0, lat, lon, altitude], frame=3))
+    lat, lon = nth_waypoint(document)["params"][4:6]
+    items.insert(items.index(nth_waypoint(document, 2)),
+                 item(command, [first_param, 0, 0, 0, lat, lon, altitude], frame=3))
 
 
 # -- one validation of option values, the same everywhere ------------------------------------
@@ -250,11 +257,11 @@ def test_a_split_that_fits_is_found(tmp_path):
 # -- missions checked as plan checks what it writes -------------------------------------------
 
 @pytest.mark.parametrize("change,words", [
-    (lambda d: d["mission"]["items"][2].__setitem__("command", 9999), ["command 9999 is no MAVLink command"]),
-    (lambda d: d["mission"]["items"][3]["params"].__setitem__(slice(4, 6), [0, 0]), ["km from home"]),
-    (lambda d: d["mission"]["items"][3]["params"].__setitem__(4, 90.0), ["km from home"]),
+    (lambda d: nth_waypoint(d, 0).__setitem__("command", 9999), ["command 9999 is no MAVLink command"]),
+    (lambda d: nth_waypoint(d)["params"].__setitem__(slice(4, 6), [0, 0]), ["km from home"]),
+    (lambda d: nth_waypoint(d)["params"].__setitem__(4, 90.0), ["km from home"]),
     (lambda d: at_waypoint(d, 18, 1e6), ["ArduPilot keeps from 1 to 255 turns"]),
-    (lambda d: d["mission"]["items"][3]["params"].__setitem__(6, 50_000), ["beyond the 10,000 m"]),
+    (lambda d: nth_waypoint(d)["params"].__setitem__(6, 50_000), ["beyond the 10,000 m"]),
 ])
 def test_missions_no_autopilot_would_fly_as_planned_are_refused(site, tmp_path, change, words):
     plan = edited(site, tmp_path, change)
@@ -274,7 +281,7 @@ def test_waypoints_underground_in_the_amsl_frame_are_refused(site, tmp_path):
 
 
 def test_upload_holds_a_file_to_the_altitude_floor(site, tmp_path):
-    plan = edited(site, tmp_path, lambda d: d["mission"]["items"][3]["params"].__setitem__(6, 2.0))
+    plan = edited(site, tmp_path, lambda d: nth_waypoint(d)["params"].__setitem__(6, 2.0))
     refused(run("upload", plan, "--connect", "udpout:127.0.0.1:9"),
             "below the altitude floor of 30 m", "at 2 m above home")
 
