@@ -596,6 +596,12 @@ def _report_mission(mission) -> None:
         say(f"  predicted flight {guidance.predicted_flight_m / 1e3:,.2f} km against "
             f"{guidance.planned_flight_m / 1e3:,.2f} km of exact path (take-off to the "
             "last target, and its loiter if it has one)")
+        slowed = [item.params[1] for item in mission.items if item.role == "speed"][1:]
+        slow = [v for v in slowed if v < (mission.cruise_speed_m_s or max(slowed, default=0.0))]
+        if slow:
+            say(f"  {len(slow)} slow zones (DO_CHANGE_SPEED to {min(slow):g} m/s and back) "
+                "before targets the guidance holds better slower")
+        record(slow_zones=len(slow))
     else:
         say(f"mission ({flavour}): {summary['items']} items, {summary['vehicle_slots']} "
             f"vehicle slots; waypoints within {mission.tolerance_m:.2f} m of the exact path")

@@ -65,6 +65,11 @@ def test_site_example_to_every_format_and_a_plot_designed_for_a_stock_ardupilot(
     assert len([i for i in items if i["command"] == 16 and i["params"][1] > 0]) == 272 + revisits
     assert "designed for the autopilot's guidance" in result.stdout
     assert "predicted flight" in result.stdout and "km of exact path" in result.stdout
+    # the slow zones the report counts are the DO_CHANGE_SPEED items below the airspeed
+    zones = re.search(r"(\d+) slow zones \(DO_CHANGE_SPEED to ([\d.]+) m/s and back\)", result.stdout)
+    slow = [i["params"][1] for i in items if i["command"] == 178 and i["params"][1] < 22.0]
+    assert (int(zones.group(1)) if zones else 0) == len(slow)
+    assert not zones or float(zones.group(2)) == min(slow) == 16.5
     # what could not be held is named, with the design limit and the margin it keeps
     if re.search(r"[1-9]\d* of 272 targets are predicted beyond", result.stderr + result.stdout):
         assert re.search(r"\d+ of 272 targets are predicted beyond 3.5 m \(--max-miss 5 m less "
