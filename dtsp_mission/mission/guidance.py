@@ -192,6 +192,10 @@ class DesignTuning:
     #: ... and the targets the design at the airspeed leaves beyond are flown slower from the
     #: start of a second design (its whole repair aims for the slower flight).
     slow_from_start: bool = True
+    #: ... that first design's local repair passes (it only finds the targets to slow for;
+    #: measured, docs/design-time.md: 0 instead of 3 plans the bundled site in 33.5 s instead
+    #: of 63 s on one core, every benchmark site held in the model, flights within 2 %).
+    slow_first_refine_passes: int = 0
     revisit_turn_m: float = 80.0
     revisit_apart: int = 4
     revisit_rounds: int = 3

@@ -94,7 +94,8 @@ def design_for_guidance(path: FlightPath, tour: Tour, frame: LocalFrame, targets
         # start of a second design: its repair aims every waypoint for the speed it is flown
         # at.  (Starting it from the first design's waypoints and aims was measured: bundled
         # site 28.6 km instead of 25.1 km, no faster.)
-        first = designed(replace(tuning, revisits=False, slow_rounds=0))
+        first = designed(replace(tuning, revisits=False, slow_rounds=0,
+                                 refine_passes=min(tuning.refine_passes, tuning.slow_first_refine_passes)))
         stuck = tuple(int(t) for t in np.flatnonzero(
             first.judged_miss_m > settings.design_limit_m - tuning.slow_margin_m))
         design = designed(tuning, stuck) if stuck else first
