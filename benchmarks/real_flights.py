@@ -56,7 +56,8 @@ CODES = {"3177ef3": "3177ef3, before the real flights (the baseline)",
          "42075cb5": "and slow zones (DO_CHANGE_SPEED) before second passes (a step, not committed)",
          "b559873e": "and those flights held 0.5 m within the limit, slow zones also for targets "
                      "held by less than 0.5 m, no wider tours (a step, not committed)",
-         "b4e643b5": "596fe8f: the same, and the take-off flown where the vehicle stores it"}
+         "b4e643b5": "596fe8f: the same, and the take-off flown where the vehicle stores it",
+         "c868f550": "the first of the two designs without its local repair (2-3 x faster plans)"}
 CSV_CASES = ROOT / "docs" / "real-flights.csv"
 CSV_TARGETS = ROOT / "docs" / "real-flights-targets.csv"
 RHO_M, ALTITUDE_M = 80.0, 120.0
