@@ -159,7 +159,7 @@ CASE_FIELDS = ["case", "autopilot", "site", "wind", "tuning", "targets", "items"
                "real_median_m", "real_p95_m", "real_max_m", "model_beyond_5m", "model_max_m",
                "diff_median_m", "diff_p95_m", "diff_max_m", "real_flown_m", "model_flown_m",
                "tour_m", "flown_over_tour", "real_time_s", "model_time_s", "plan_s", "flight_wall_s",
-               "worst_target", "when", "code"]
+               "worst_target", "when", "code", "tour_time_s", "time_over_tour"]
 
 
 def run_case(case: str, binaries) -> tuple[dict, list[dict]]:
@@ -191,12 +191,54 @@ def run_case(case: str, binaries) -> tuple[dict, list[dict]]:
            "plan_s": f"{plan_s:.1f}", "flight_wall_s": f"{flight.wall_s:.0f}",
            "worst_target": f"{report.names[worst]} {real[worst]:.1f} m (model {model[worst]:.1f})",
            "when": time.strftime("%Y-%m-%d %H:%M"), "code": _code_version()[:8]}
+    tour_s = tour_time_s(summary, autopilot)
+    row.update(tour_time_s=f"{tour_s:.1f}", time_over_tour=f"{report.real_time_s / tour_s:.3f}")
     targets = [{"case": case, "target": name, "real_miss_m": f"{r:.3f}", "model_miss_m": f"{m:.3f}",
                 "code": row["code"]} for name, r, m in zip(report.names, real, model)]
     return row, targets
 
 
+def tour_time_s(summary: dict, autopilot: str) -> float:
+    """The tour's flight time the flight is measured against: in wind the tour planned for
+    that wind (``plan``'s ``wind_tour_time_s``), in calm air the tour at the airspeed."""
+    if "wind_tour_time_s" in summary:
+        return float(summary["wind_tour_time_s"])
+    return float(summary["tour_length_m"]) / AIRSPEED[autopilot]
+
+
+def _filled_tour_times(rows: list[dict]) -> None:
+    """Rows flown before the CSV had ``tour_time_s``: the tour's time from the plans in the
+    cache with the same tour and wind (the calm tour at the airspeed in calm air)."""
+    known = {}
+    for path in CACHE.glob("*.json"):
+        summary = json.loads(path.read_text())
+        wind = summary.get("design_wind") or {}
+        if "wind_tour_time_s" in summary:
+            key = (round(summary["tour_length_m"]), f"{wind['speed_m_s']:g}@{wind['from_deg']:g}")
+            known[key] = summary["wind_tour_time_s"]
+    for row in rows:
+        if row.get("tour_time_s"):
+            continue
+        if row["wind"] == "calm":
+            tour_s = float(row["tour_m"]) / AIRSPEED[row["autopilot"]]
+        else:
+            tour_s = known.get((round(float(row["tour_m"])), row["wind"]), math.nan)
+        row["tour_time_s"] = f"{tour_s:.1f}"
+        row["time_over_tour"] = f"{float(row['real_time_s']) / tour_s:.3f}"
+
+
 def _append(path: Path, fields: list[str], rows: list[dict]) -> None:
+    """``rows`` appended to the CSV at ``path``; a CSV written with fewer columns is
+    rewritten first with ``fields`` (the new columns empty in its rows)."""
+    if path.exists():
+        with path.open(newline="") as handle:
+            reader = csv.DictReader(handle)
+            if reader.fieldnames != fields:
+                old = list(reader)
+                with path.open("w", newline="") as out:
+                    writer = csv.DictWriter(out, fieldnames=fields, restval="")
+                    writer.writeheader()
+                    writer.writerows(old)
     new = not path.exists()
     with path.open("a", newline="") as handle:
         writer = csv.DictWriter(handle, fieldnames=fields)
@@ -218,6 +260,7 @@ def markdown(out: Path) -> None:
     earlier ones counted), and the model-against-real distribution over all targets."""
     with CSV_CASES.open() as handle:
         rows = list(csv.DictReader(handle))
+    _filled_tour_times(rows)
     latest, runs, earlier = {}, {}, {}
     for row in rows:
         earlier.setdefault(row["case"], row)          # the first flight of the case
@@ -234,7 +277,9 @@ def markdown(out: Path) -> None:
              "waypoint. *beyond* counts targets the real track passed farther than 5 m from; "
              "*model vs real* is |real miss - model miss| per target, the model flying the same "
              "mission, aircraft and wind; *flown / tour* the real track from the take-off's "
-             "completion to the last waypoint over the closed tour at rho 80.",
+             "completion to the last waypoint over the closed tour at rho 80; *time / tour* that "
+             "flight's time over the tour's: in calm air the tour at the airspeed, in wind the "
+             "tour planned for that wind (`plan`'s *tour in the forecast wind*).",
              "",
              "Tunings: `p18` NAVL1_PERIOD 18, NAVL1_DAMPING 0.85, WP_RADIUS 80; `p12` NAVL1_PERIOD 12, "
              "WP_RADIUS 30, ROLL_LIMIT_DEG 45; `p20` NAVL1_PERIOD 20, WP_RADIUS 60.",
@@ -243,9 +288,9 @@ def markdown(out: Path) -> None:
              "the CSV: a digest of the package's source; every flight is listed at the end).",
              "",
              "| case | targets | items | beyond 5 m | real miss median / p95 / max m | model: beyond, max m "
-             "| model vs real median / p95 / max m | flown / tour | real / model time s | plan s | worst "
-             "| flights |",
-             "|---|---:|---:|---:|---|---|---|---:|---|---:|---|---:|"]
+             "| model vs real median / p95 / max m | flown / tour | time / tour | real / model time s "
+             "| plan s | worst | flights |",
+             "|---|---:|---:|---:|---|---|---|---:|---:|---|---:|---|---:|"]
     for case in sorted(latest, key=lambda c: all_cases().index(c) if c in all_cases() else 1e9):
         r = latest[case]
         was = f" (was {earlier[case]['beyond_5m']})" if case in earlier else ""
@@ -254,7 +299,7 @@ def markdown(out: Path) -> None:
                      f"{float(r['real_max_m']):.1f} | {r['model_beyond_5m']}, "
                      f"{float(r['model_max_m']):.1f} | {float(r['diff_median_m']):.1f} / "
                      f"{float(r['diff_p95_m']):.1f} / {float(r['diff_max_m']):.1f} | "
-                     f"{r['flown_over_tour']} | {float(r['real_time_s']):.0f} / "
+                     f"{r['flown_over_tour']} | {r['time_over_tour']} | {float(r['real_time_s']):.0f} / "
                      f"{float(r['model_time_s']):.0f} | {r['plan_s']} | {r['worst_target']} | "
                      f"{runs[case]} |")
     clean = sum(1 for r in latest.values() if int(r["beyond_5m"]) == 0)
@@ -280,11 +325,12 @@ def markdown(out: Path) -> None:
                              f"{(real[chosen] > 5).sum()} |")
     lines += ["", "## Every flight", "",
               "Code digests: " + "; ".join(f"`{k}` {v}" for k, v in CODES.items()) + ".", "",
-              "| case | code | when | beyond 5 m | real max m | model vs real p95 / max m | flown / tour |",
-              "|---|---|---|---:|---:|---|---:|"]
+              "| case | code | when | beyond 5 m | real max m | model vs real p95 / max m | flown / tour "
+              "| time / tour |",
+              "|---|---|---|---:|---:|---|---:|---:|"]
     lines += [f"| {r['case']} | {r['code']} | {r['when']} | {r['beyond_5m']} | {float(r['real_max_m']):.1f} | "
-              f"{float(r['diff_p95_m']):.1f} / {float(r['diff_max_m']):.1f} | {r['flown_over_tour']} |"
-              for r in rows]
+              f"{float(r['diff_p95_m']):.1f} / {float(r['diff_max_m']):.1f} | {r['flown_over_tour']} "
+              f"| {r['time_over_tour']} |" for r in rows]
     out.write_text("\n".join(lines) + "\n")
     print(f"wrote {out}")
 

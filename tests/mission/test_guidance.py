@@ -8,6 +8,7 @@ that a real aircraft passes the targets: the model's agreement with real ArduPla
 
 from __future__ import annotations
 
+import os
 from dataclasses import replace
 
 import numpy as np
@@ -463,6 +464,32 @@ def test_slow_zones_start_far_enough_before_each_target_and_end_at_it():
     assert speeds[6] == 16.0 and all(v != v for v in speeds[7:])
 
 
+def test_a_slow_zone_starts_at_a_waypoint_of_its_own_where_the_leg_before_is_long():
+    """The speed changes where a waypoint is reached: a zone whose last waypoint far enough
+    before its target is a long leg back gets a slowing waypoint where it should start, so
+    the zone is as long as asked, not a whole leg longer."""
+    from dtsp_mission.mission.guidance import _slow_zones, _with_zone_starts
+    s_wp = [0.0, 100.0, 900.0, 1000.0, 1500.0, 1560.0, 2600.0]
+    target_of = [0, 1, 2, 3, 4, 5, 6]
+    # targets 2 (at 900 m: its zone should start at 650 m, the waypoint before is at 100 m),
+    # 3 (its zone starts inside target 2's: no waypoint), 5 (starts at 1310 m, 190 m after
+    # the waypoint at 1000 m) and 6 (starts at 2350 m, 790 m after 1560 m): waypoints
+    s_new, of_new, inserted = _with_zone_starts(s_wp, target_of, {2, 3, 5, 6}, 250.0, 45.0, {})
+    assert [round(s_new[k]) for k in inserted] == [650, 1310, 2350]
+    assert all(of_new[k] == -1 for k in inserted)
+    assert s_new == sorted(s_new) and len(s_new) == len(s_wp) + 3
+    speeds = _slow_zones(s_new, of_new, [2, 3, 5, 6], 16.0, 22.0, 250.0)
+    # slow from the item after each slowing waypoint, back after target 3's and 5's waypoints
+    slow_from = [k for k, v in enumerate(speeds) if v == 16.0]
+    assert slow_from == [k + 1 for k in inserted]
+    # one within the slack before the start (1000 m for a zone from 1010 m): no waypoint
+    _, _, none = _with_zone_starts(s_wp, target_of, {4}, 490.0, 45.0, {})
+    assert none == []
+    # not inside a loiter, nor before the path
+    _, _, none = _with_zone_starts(s_wp, target_of, {2, 1}, 250.0, 45.0, {600.0: 700.0})
+    assert none == []
+
+
 @pytest.mark.heavy(seconds=60)
 def test_targets_the_design_cannot_hold_at_the_airspeed_are_flown_slower(clustered_stuck):
     """On the clustered site, without second passes: slow zones (DO_CHANGE_SPEED to 75 % of the
@@ -510,3 +537,44 @@ def test_a_tour_with_lead_ins_is_designed_with_a_waypoint_where_each_straight_be
                             np.array([i.longitude_deg for i in shaping]))
     for point in starts:          # there, or moved a little by the local repair
         assert np.hypot(*(placed - point).T).min() < 15.0
+
+
+_ONE_DESIGN = """
+import hashlib, os, sys
+import os
+from dataclasses import replace
+sys.path.insert(0, {tests!r})
+from mission.test_guidance import _clustered, CENTRE
+from dtsp_mission.api import plan_tour
+from dtsp_mission.mission import DesignTuning, MissionSettings, build_mission
+if {one_core}:
+    os.sched_setaffinity(0, {{min(os.sched_getaffinity(0))}})
+targets = _clustered(80, 2)
+tour, frame = plan_tour(targets, 80.0)
+settings = MissionSettings(design="guidance", airspeed_m_s=22.0, altitude_m=120.0,
+                           home_deg=CENTRE, wind_spread_m_s=0.0,
+                           tuning=DesignTuning(revisits=False, slow_rounds=0))
+mission = build_mission(tour, frame, targets, settings)
+print(hashlib.sha256(repr([(i.command, i.latitude_deg, i.longitude_deg, i.params)
+                            for i in mission.items]).encode()).hexdigest(),
+      mission.guidance.design_rounds)
+"""
+
+
+@pytest.mark.heavy(seconds=60)
+@pytest.mark.skipif(not hasattr(os, "sched_getaffinity") or len(os.sched_getaffinity(0)) < 2,
+                    reason="needs two cores to compare with one")
+def test_the_design_is_the_same_on_one_core_and_on_several():
+    """The design flies its trials on every core (the local repair's moves of a step, the
+    conditions of a trial): what it chooses does not depend on the machine -- the mission
+    designed pinned to one core is item for item the one designed on all of them (the clustered
+    site whose local repair has targets to work on)."""
+    import subprocess
+    import sys
+    from pathlib import Path
+    tests = str(Path(__file__).resolve().parents[1])
+    results = [subprocess.run([sys.executable, "-c", _ONE_DESIGN.format(tests=tests, one_core=one)],
+                              capture_output=True, text=True, timeout=300, check=True).stdout.split()
+               for one in (True, False)]
+    assert results[0] == results[1]
+    assert int(results[0][1]) > 0
