@@ -180,11 +180,17 @@ class DesignTuning:
     #: AIRSPEED_MIN), from the last waypoint at least the slowing-down distance and
     #: ``slow_settle_l1`` L1 distances before each, back to the airspeed after it; up to
     #: ``slow_rounds`` rounds (each adds the targets then beyond), each kept only if the robust
-    #: cost falls.  Costs two DO_CHANGE_SPEED items per zone and a little time, no length.
+    #: cost falls.  Costs two DO_CHANGE_SPEED items per zone and time (the aircraft flies 25 %
+    #: slower there), no length.  One round: after the second design, which slows for the
+    #: targets the first left beyond from the start, a second or third round held nothing
+    #: more on 16 benchmark cases in the model (docs/design-time.md; one held it with fewer
+    #: second passes) and costs a local repair each (6 s of the 400-target site's design).
+    #: 0.85 of the airspeed instead of 0.75 left more targets to second passes (1.17 instead
+    #: of 1.15 x the tour's time on 9 cases, measured with ``slow_start_slack_l1`` 0.5).
     slow_airspeed_ratio: float = 0.75
     slow_min_airspeed_m_s: float = 14.0
     slow_settle_l1: float = 1.0
-    slow_rounds: int = 3
+    slow_rounds: int = 1
     #: With a value, a zone starts at a waypoint of its own (a slowing waypoint on the leg the
     #: guidance flies there) unless one already stands within this many L1 distances before
     #: the point it should start at: the speed changes where a waypoint is reached, and the
