@@ -366,7 +366,7 @@ def remodel(cases: list[str], airframe_change: dict | None = None) -> None:
               f"{(report.model_miss_m > 5).sum()} (max {report.model_miss_m.max():.1f}); model vs "
               f"real median {np.median(diff):.2f} p95 {np.percentile(diff, 95):.2f} max "
               f"{diff.max():.2f} m; flown real {report.real_flown_m:.0f} model "
-              f"{report.model_flown_m:.0f} m")
+              f"{report.model_flown_m:.0f} m in {report.real_time_s:.0f} / {report.model_time_s:.0f} s")
     if every:
         diff = np.concatenate(every)
         print(f"all {len(diff)} targets: model vs real median {np.median(diff):.2f} p95 "
