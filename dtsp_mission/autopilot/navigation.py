@@ -485,12 +485,24 @@ _APPROACH_CAP_M = 60.0
 
 @dataclass(frozen=True)
 class Checkpoint:
-    """A flight as an item became current: the flight (to continue on its own), the track
-    rows of the run recorded before it, and the least distance to each point so far."""
+    """A flight as an item became current: the flight it was taken from and its state then
+    (restored only when asked for: a run takes hundreds, a design uses few), the track rows of
+    the run recorded before it, and the least distance to each point so far."""
 
-    flight: "MissionFlight"
+    source: "MissionFlight"
+    state: np.ndarray
     rows: int
     closest_m: np.ndarray
+
+    @property
+    def flight(self) -> "MissionFlight":
+        """A new flight from the checkpoint on, continuing on its own."""
+        return self.source._restored(self.state)
+
+    def resumed(self, items: "list[LocalItem] | MissionArrays") -> "MissionFlight":
+        """A new flight from the checkpoint on, flying ``items`` (the same seqs, other
+        positions or parameters) from here instead of the flight's own."""
+        return self.source._restored(self.state, items)
 
 
 @dataclass(frozen=True)
@@ -645,12 +657,14 @@ class MissionFlight:
                   np.ascontiguousarray(points[far]), again, measure_from, math.inf)
             best[far] = again
         track_rows = np.concatenate(chunks) if chunks else np.zeros((0, 4))
-        checkpoints = {}
-        for k in np.flatnonzero(mark_array):
-            if not np.isnan(saved[k, 0]):
-                rows = int(np.searchsorted(track_rows[:, 0], saved[k, K.S_TIME], side="right"))
-                checkpoints[int(m.seq[k])] = Checkpoint(self._restored(saved[k]), rows,
-                                                        saved[k, K.STATE_SIZE:].copy())
+        taken = np.flatnonzero(mark_array)
+        taken = taken[~np.isnan(saved[taken, 0])]
+        rows = np.searchsorted(track_rows[:, 0], saved[taken, K.S_TIME], side="right")
+        # the flight goes on from here (a later run): its reach events after a checkpoint are
+        # dropped when the checkpoint is restored, and its state is copied here
+        checkpoints = {int(m.seq[k]): Checkpoint(self, saved[k, :K.STATE_SIZE],
+                                                 int(r), saved[k, K.STATE_SIZE:])
+                       for k, r in zip(taken, rows)}
         return FlightRun(track_rows, best, self.measured_length_m, checkpoints, int(stopped))
 
     @property

@@ -556,7 +556,7 @@ def _refine(aim: np.ndarray, target_of: list[int], items: list[LocalItem], seqs:
                 return mission.with_positions(movable_index, points[movable] - home)
 
             def flown(changed: MissionArrays, checkpoint) -> np.ndarray:
-                return checkpoint.flight.copy(changed).run(
+                return checkpoint.resumed(changed).run(
                     tuning.verify_step_s, seqs[end], track=False, points_m=local_targets[window],
                     closest_m=checkpoint.closest_m[window], measure_from_seq=_AFTER_TAKEOFF,
                     until_s=FLIGHT_LIMIT_S).closest_m
@@ -650,7 +650,7 @@ def _refine(aim: np.ndarray, target_of: list[int], items: list[LocalItem], seqs:
                 continue
             changed = with_aims(candidate)
             later = {q for q in seq_set if q >= seqs[begin]}
-            runs = _each(lambda checkpoint: checkpoint.flight.copy(changed).run(
+            runs = _each(lambda checkpoint: checkpoint.resumed(changed).run(
                              tuning.verify_step_s, last, track=False, marks=later,
                              points_m=local_targets,
                              closest_m=checkpoint.closest_m, measure_from_seq=_AFTER_TAKEOFF,

@@ -58,13 +58,17 @@ def test_a_checkpoint_goes_on_exactly_as_the_flight_it_was_taken_from():
     flight = MissionFlight(items, SHIPPED, 0.0, 1, Wind(5.0, 90.0))
     whole = flight.run(0.02, len(items) - 2, points_m=points, marks={4}, measure_from_seq=2)
     checkpoint = whole.checkpoints[4]
-    resumed = checkpoint.flight.run(0.02, len(items) - 2, points_m=points,
-                                    closest_m=checkpoint.closest_m, measure_from_seq=2)
+    again = checkpoint.flight
+    assert again.reached == [event for event in flight.reached if event[0] < 4]
+    resumed = again.run(0.02, len(items) - 2, points_m=points,
+                        closest_m=checkpoint.closest_m, measure_from_seq=2)
     np.testing.assert_array_equal(np.vstack([whole.track[:checkpoint.rows], resumed.track]),
                                   whole.track)
     np.testing.assert_array_equal(resumed.closest_m, whole.closest_m)
-    assert checkpoint.flight.reached == flight.reached
+    assert again.reached == flight.reached
     assert resumed.measured_length_m == whole.measured_length_m
+    # a checkpoint is not used up: taken again it starts where it was taken
+    assert checkpoint.flight.reached == [event for event in flight.reached if event[0] < 4]
 
 
 @pytest.mark.parametrize("from_deg,factor", [(90.0, -1), (270.0, 1)])
