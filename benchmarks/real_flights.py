@@ -57,7 +57,11 @@ CODES = {"3177ef3": "3177ef3, before the real flights (the baseline)",
          "b559873e": "and those flights held 0.5 m within the limit, slow zones also for targets "
                      "held by less than 0.5 m, no wider tours (a step, not committed)",
          "b4e643b5": "596fe8f: the same, and the take-off flown where the vehicle stores it",
-         "c868f550": "the first of the two designs without its local repair (2-3 x faster plans)"}
+         "c868f550": "the first of the two designs without its local repair (2-3 x faster plans)",
+         "65f0ec6b": "3efe14e: the same design as c868f550 (the local repair's moves flown on both "
+                     "cores)",
+         "4448bf84": "9e377aa: one round of slow zones; PX4's SIH flown no faster than 13.9 m/s "
+                     "(the PX4 missions designed for it)"}
 CSV_CASES = ROOT / "docs" / "real-flights.csv"
 CSV_TARGETS = ROOT / "docs" / "real-flights-targets.csv"
 RHO_M, ALTITUDE_M = 80.0, 120.0
@@ -274,7 +278,8 @@ def markdown(out: Path) -> None:
              "design, rho 80 m, 120 m; ArduPlane 22 m/s, PX4 18 m/s; the case's `--wind` and "
              "`--vehicle-params`), uploaded to a fresh real SITL autopilot (ArduPlane V4.8.0-dev, "
              "PX4 v1.16.0 SIH; stock but for the tuning and the wind) and flown to the last "
-             "waypoint. *beyond* counts targets the real track passed farther than 5 m from; "
+             "waypoint (PX4's SIH has no wind: PX4 is flown in calm air only). *beyond* counts "
+             "targets the real track passed farther than 5 m from; "
              "*model vs real* is |real miss - model miss| per target, the model flying the same "
              "mission, aircraft and wind; *flown / tour* the real track from the take-off's "
              "completion to the last waypoint over the closed tour at rho 80; *time / tour* that "
