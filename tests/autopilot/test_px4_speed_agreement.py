@@ -4,7 +4,6 @@ model, flying it so, passes the targets and takes the time the real one did."""
 
 from __future__ import annotations
 
-import csv
 from pathlib import Path
 
 import numpy as np
@@ -12,24 +11,19 @@ import pytest
 
 from dtsp_mission.autopilot.navigation import Airframe, closest_approach_m
 from dtsp_mission.autopilot.parameters import PX4_DEFAULTS
-from dtsp_mission.export import read_mission
 from dtsp_mission.frame import LocalFrame
 from dtsp_mission.sim.fly import targets_in
 from dtsp_mission.sim.predict import predict_flight
 from dtsp_mission.sitl.flight import measured_span, mission_seqs
+
+from .recorded import read_recorded
 
 DATA = Path(__file__).resolve().parents[1] / "data" / "px4-sitl-speed"
 
 
 @pytest.fixture(scope="module")
 def recorded():
-    mission = read_mission(str(DATA / "mission.plan"), None)
-    with (DATA / "track.csv").open() as handle:
-        track = np.array([[float(r["time_s"]), float(r["east_m"]), float(r["north_m"])]
-                          for r in csv.DictReader(handle)])
-    with (DATA / "reached.csv").open() as handle:
-        reached = {int(r["seq"]): float(r["time_s"]) for r in csv.DictReader(handle)}
-    return mission, track, reached
+    return read_recorded(DATA)
 
 
 def test_the_sih_plane_flies_no_faster_than_it_can_whatever_the_mission_asks():

@@ -4,7 +4,6 @@ and the navigation at the lower airspeed passes the waypoints as the real aircra
 
 from __future__ import annotations
 
-import csv
 from dataclasses import replace
 from pathlib import Path
 
@@ -13,21 +12,17 @@ import pytest
 
 from dtsp_mission.autopilot.navigation import Airframe, closest_approach_m
 from dtsp_mission.autopilot.commands import Command
-from dtsp_mission.export import read_mission
 from dtsp_mission.frame import LocalFrame
 from dtsp_mission.sim.predict import predict_flight
+
+from .recorded import read_recorded
 
 DATA = Path(__file__).resolve().parents[1] / "data" / "arduplane-sitl-speed"
 
 
 @pytest.fixture(scope="module")
 def recorded():
-    mission = read_mission(str(DATA / "mission.plan"), None)
-    with (DATA / "track.csv").open() as handle:
-        track = np.array([[float(r["time_s"]), float(r["east_m"]), float(r["north_m"])]
-                          for r in csv.DictReader(handle)])
-    with (DATA / "reached.csv").open() as handle:
-        reached = {int(r["seq"]): float(r["time_s"]) for r in csv.DictReader(handle)}
+    mission, track, reached = read_recorded(DATA)
     frame = LocalFrame(mission.home.latitude_deg, mission.home.longitude_deg)
     waypoints = [item for item in mission.items if int(item.command) == Command.NAV_WAYPOINT]
     points = frame.to_local(np.array([w.latitude_deg for w in waypoints]),

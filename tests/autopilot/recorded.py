@@ -1,0 +1,22 @@
+"""A real SITL flight kept in ``tests/data``: its mission, track and reach events."""
+
+from __future__ import annotations
+
+import csv
+from pathlib import Path
+
+import numpy as np
+
+from dtsp_mission.export import read_mission
+
+
+def read_recorded(directory: Path):
+    """(mission, track rows (time s, east m, north m), {seq: first reach time s}) of the flight
+    in ``directory`` (``mission.plan``, ``track.csv``, ``reached.csv``)."""
+    mission = read_mission(str(directory / "mission.plan"), None)
+    with (directory / "track.csv").open() as handle:
+        track = np.array([[float(r["time_s"]), float(r["east_m"]), float(r["north_m"])]
+                          for r in csv.DictReader(handle)])
+    with (directory / "reached.csv").open() as handle:
+        reached = {int(r["seq"]): float(r["time_s"]) for r in csv.DictReader(handle)}
+    return mission, track, reached
