@@ -61,9 +61,13 @@ def test_the_fence_and_rally_points_reach_the_real_autopilot(tmp_path, autopilot
     px4 = autopilot == "px4"
     sitl_class = Px4Sitl if px4 else ArduPlaneSitl
     with sitl_class(BINARIES.px4 if px4 else BINARIES.arduplane, settings) as sitl:
+        # the transfers may take up to 120 s each: PX4's SIH on the wall clock, on a machine
+        # busy with the rest of the suite, fell silent long enough to end the default 32 s
+        # (a CI run: its verifying download restarted and found no answer in time)
         uploaded = subprocess.run(CLI + ["upload", str(plan), "--connect", sitl.connection,
-                                         "--heartbeat-timeout", "60", "--json"],
-                                  capture_output=True, text=True, timeout=240)
+                                         "--heartbeat-timeout", "60", "--timeout", "120",
+                                         "--json"],
+                                  capture_output=True, text=True, timeout=600)
         assert uploaded.returncode == 0, uploaded.stderr
         parts = json.loads(uploaded.stdout)["upload"]["parts"]
         assert parts == [f"geofence: {len(mission.fence)} items sent, downloaded back equal",
