@@ -175,8 +175,9 @@ class Airframe:
         ``tests/data/px4-sitl``) under PX4's NPFG guidance; ``airspeed_m_s`` is the airspeed
         asked for (its trim airspeed, ``FW_AIRSPD_TRIM``, if None; PX4 flies no faster than
         ``FW_AIRSPD_MAX``, the SIH plane no faster than :data:`SIH_MAX_AIRSPEED_M_S`)."""
-        asked = min(airspeed_m_s or parameters.FW_AIRSPD_TRIM, parameters.FW_AIRSPD_MAX)
-        return cls(min(asked * SIH_AIRSPEED_RATIO, SIH_MAX_AIRSPEED_M_S), parameters.FW_R_LIM,
+        asked = airspeed_m_s or parameters.FW_AIRSPD_TRIM
+        top = min(parameters.FW_AIRSPD_MAX * SIH_AIRSPEED_RATIO, SIH_MAX_AIRSPEED_M_S)
+        return cls(min(asked * SIH_AIRSPEED_RATIO, top), parameters.FW_R_LIM,
                    parameters.NPFG_PERIOD,
                    parameters.NAV_ACC_RAD, roll_natural_rad_s=SIH_ROLL_NATURAL_RAD_S,
                    roll_damping=SIH_ROLL_DAMPING, l1_damping=parameters.NPFG_DAMPING,
@@ -188,8 +189,7 @@ class Airframe:
                    autopilot="px4", switch_distance_multiplier=parameters.NPFG_SW_DST_MLT,
                    airspeed_ratio=SIH_AIRSPEED_RATIO, airspeed_time_constant_s=SIH_AIRSPEED_TC_S,
                    takeoff_airspeed_m_s=SIH_TAKEOFF_AIRSPEED_M_S,
-                   max_airspeed_m_s=min(parameters.FW_AIRSPD_MAX * SIH_AIRSPEED_RATIO,
-                                        SIH_MAX_AIRSPEED_M_S),
+                   max_airspeed_m_s=top,
                    takeoff_end_airspeed_ratio=0.0, bank_airspeed_gain_m_s=0.0)
 
     @classmethod
@@ -660,8 +660,8 @@ class MissionFlight:
         taken = np.flatnonzero(mark_array)
         taken = taken[~np.isnan(saved[taken, 0])]
         rows = np.searchsorted(track_rows[:, 0], saved[taken, K.S_TIME], side="right")
-        # the flight goes on from here (a later run): its reach events after a checkpoint are
-        # dropped when the checkpoint is restored, and its state is copied here
+        # a checkpoint refers to this flight, which may fly on: restoring one copies the
+        # saved state and drops the reach events after it
         checkpoints = {int(m.seq[k]): Checkpoint(self, saved[k, :K.STATE_SIZE],
                                                  int(r), saved[k, K.STATE_SIZE:])
                        for k, r in zip(taken, rows)}

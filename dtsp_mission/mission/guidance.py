@@ -774,6 +774,11 @@ def _slow_zones(s_wp, target_of: list[int], beyond: list[int], slow_m_s: float,
     return speeds
 
 
+def _speed_items(speeds: list[float]) -> int:
+    """The DO_CHANGE_SPEED items of per-waypoint ``speeds`` (:func:`_slow_zones`)."""
+    return sum(math.isfinite(v) for v in speeds)
+
+
 def _with_zone_starts(s_wp: list[float], target_of: list[int], among, before_m: float,
                       slack_m: float, loiter_ends: dict[float, float]
                       ) -> tuple[list[float], list[int], list[int]]:
@@ -884,7 +889,7 @@ def design_waypoints(path: FlightPath, targets_m: np.ndarray, altitudes_m: np.nd
             return None
         speeds = _slow_zones(list(s_wp), list(target_of), sorted(among), slow_m_s,
                              airframe.airspeed_m_s, slow_before_m)
-        if len(s_wp) + sum(math.isfinite(v) for v in speeds) > budget:
+        if len(s_wp) + _speed_items(speeds) > budget:
             return None                 # no room for the speed changes
         return speeds
 
@@ -1034,8 +1039,7 @@ def design_waypoints(path: FlightPath, targets_m: np.ndarray, altitudes_m: np.nd
         if kind == failed:
             continue
         beyond = [int(t) for t in np.flatnonzero(miss > verify_miss_m)]
-        room = (budget - len(target_final) - sum(math.isfinite(v) for v in speeds_final)
-                ) // (1 if kind == 0.0 else 3)
+        room = (budget - len(target_final) - _speed_items(speeds_final)) // (1 if kind == 0.0 else 3)
         if not beyond or room <= 0:
             break
         s_new, target_new, aim_new, speeds_new = _with_revisits(

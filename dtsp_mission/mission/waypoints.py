@@ -80,13 +80,15 @@ def design_for_guidance(path: FlightPath, tour: Tour, frame: LocalFrame, targets
     altitudes = (np.full(len(tour.targets_m), settings.altitude_m) if targets.altitudes_m is None
                  else np.asarray(targets.altitudes_m, dtype=float))
     altitudes = np.where(np.isnan(altitudes), settings.altitude_m, altitudes)   # not given
+    lead_s_m = lead_in_starts_m(path, tour)
+
     def designed(tuning: DesignTuning, slow_targets: tuple[int, ...] = ()) -> GuidanceDesign:
         return design_waypoints(path, tour.targets_m, altitudes, airframe, settings.design_limit_m,
                                 budget, head, settings.target_acceptance_m, progress=progress,
                                 as_stored=lambda points: stored_position_m(frame, points),
                                 winds=settings.design_winds(),
                                 spread_margin_m=settings.max_miss_m - settings.design_limit_m,
-                                tuning=tuning, lead_s_m=lead_in_starts_m(path, tour),
+                                tuning=tuning, lead_s_m=lead_s_m,
                                 slow_targets=slow_targets)
     tuning = settings.tuning
     if tuning.slow_rounds > 0 and tuning.slow_from_start:
