@@ -23,6 +23,7 @@ from ..autopilot.wire import first_mission_seq, to_wire
 from ..errors import LinkError
 from ..frame import LocalFrame
 from ..upload import UploadReport, upload_mission
+from ..upload.datagrams import keep_only
 from ..upload.pymavlink_link import GCS_COMPONENT_ID, GCS_SYSTEM_ID, use_mavlink2
 from .binaries import SitlBinaries
 from .processes import ArduPlaneSitl, Px4Sitl, SitlSettings
@@ -34,6 +35,8 @@ GLOBAL_POSITION_INT_ID = 33
 ARMED_FLAG = 128
 #: What is recorded after the last waypoint is reached (vehicle seconds).
 AFTER_LAST_S = 10.0
+#: What a flight's recorder reads (the rest of the vehicle's telemetry is dropped undecoded).
+RECORDS = frozenset({"HEARTBEAT", "GLOBAL_POSITION_INT", "MISSION_ITEM_REACHED", "MISSION_CURRENT"})
 
 
 @dataclass(frozen=True)
@@ -140,14 +143,18 @@ def fly_real(mission: VehicleMission, binaries: SitlBinaries, parameters: dict[s
     return RealFlight(kind, rows, reached, first, last, frame, report, time.monotonic() - started)
 
 
-def _link(connection: str):
+def _link(connection: str, listens_to: frozenset[str]):
+    """A pymavlink link to the SITL that decodes only datagrams with ``listens_to`` messages
+    (PX4 sends thousands of telemetry messages a second to the ground station's port)."""
     use_mavlink2()
     from pymavlink import mavutil
     deadline = time.monotonic() + 30.0
     while True:
         try:
-            return mavutil.mavlink_connection(connection, source_system=GCS_SYSTEM_ID,
+            link = mavutil.mavlink_connection(connection, source_system=GCS_SYSTEM_ID,
                                               source_component=GCS_COMPONENT_ID, autoreconnect=False)
+            keep_only(link, listens_to)
+            return link
         except OSError:
             if time.monotonic() > deadline:
                 raise LinkError(f"could not connect to the SITL at {connection}") from None
@@ -166,7 +173,7 @@ def _vehicle_heartbeat(link, timeout_s: float):
 
 def _wait_ready(connection: str) -> None:
     """Until the autopilot's heartbeat says STANDBY (booted, calibrated)."""
-    link = _link(connection)
+    link = _link(connection, frozenset({"HEARTBEAT"}))
     try:
         deadline = time.monotonic() + 90.0
         while time.monotonic() < deadline:
@@ -182,7 +189,7 @@ def _wait_ready(connection: str) -> None:
 def _fly(connection: str, px4: bool, first: int, last: int, budget_s: float, say) -> tuple[list, dict[int, float]]:
     """Set AUTO until it holds, arm, and record until ``last`` is reached (plus
     :data:`AFTER_LAST_S`); returns rows (time, lat, lon, height) and reach times by seq."""
-    link = _link(connection)
+    link = _link(connection, RECORDS)
     rows: list[tuple[float, float, float, float]] = []
     reached: dict[int, float] = {}
     now_s = 0.0
@@ -216,9 +223,7 @@ def _fly(connection: str, px4: bool, first: int, last: int, budget_s: float, say
                     link.mav.command_long_send(target, 1, MAV_CMD_COMPONENT_ARM_DISARM, 0, 1,
                                                0, 0, 0, 0, 0, 0)
                 last_command = wall
-            message = link.recv_match(type=["HEARTBEAT", "GLOBAL_POSITION_INT",
-                                             "MISSION_ITEM_REACHED", "MISSION_CURRENT"],
-                                      blocking=True, timeout=0.5)
+            message = link.recv_match(type=RECORDS, blocking=True, timeout=0.5)
             if message is None:
                 continue
             kind = message.get_type()

@@ -23,6 +23,7 @@ from ..autopilot.parameters import parameter_name
 from ..errors import LinkError
 from ..autopilot.commands import Command
 from .connection import check_host
+from .datagrams import keep_only
 from .base import (MIN_TIMEOUT_S, TIMEOUT_S, VEHICLE_GIVES_UP_S, Progress, Uploader, VehicleInfo,
                    transfer_timeout_s)
 from .results import ITEM_RESULTS, NO_SPACE, result_text
@@ -45,6 +46,11 @@ MAX_FRESH_STARTS = 20
 #: Request timeouts in a row without any item before a download starts a new transfer.
 DOWNLOAD_RESTART_AFTER = 4
 HEARTBEAT_PERIOD_S = 1.0
+#: Every message the uploader waits for: over UDP, datagrams with none of them are dropped
+#: undecoded (:mod:`.datagrams`), so a vehicle's telemetry cannot crowd out a transfer.
+LISTENS_TO = frozenset({"HEARTBEAT", "STATUSTEXT", "PARAM_VALUE", "HOME_POSITION", "WIND",
+                        "MISSION_REQUEST_INT", "MISSION_REQUEST", "MISSION_ACK", "MISSION_COUNT",
+                        "MISSION_ITEM_INT", "MISSION_ITEM"})
 
 
 def use_mavlink2() -> None:
@@ -93,6 +99,7 @@ class PymavlinkUploader(Uploader):
                 autoreconnect=False)
         except Exception as error:  # pymavlink raises OSError, ValueError, serial errors ...
             raise LinkError(f"cannot open the connection {self.connection!r}: {error}") from None
+        keep_only(self._link, LISTENS_TO)
         self._guard_link()
         if self.signing_key is not None:
             self._link.setup_signing(self.signing_key, sign_outgoing=True)
@@ -151,7 +158,9 @@ class PymavlinkUploader(Uploader):
             self._last_heartbeat = now
 
     def _receive(self, types: set[str], timeout_s: float):
-        """The next message of ``types`` from the vehicle, or None after ``timeout_s``."""
+        """The next message of ``types`` (all in :data:`LISTENS_TO`) from the vehicle, or None
+        after ``timeout_s``."""
+        assert types <= LISTENS_TO, types - LISTENS_TO
         deadline = time.monotonic() + timeout_s
         while True:
             self._heartbeat()
