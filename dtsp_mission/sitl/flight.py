@@ -35,7 +35,8 @@ GLOBAL_POSITION_INT_ID = 33
 ARMED_FLAG = 128
 #: What is recorded after the last waypoint is reached (vehicle seconds).
 AFTER_LAST_S = 10.0
-#: What a flight's recorder reads (the rest of the vehicle's telemetry is dropped undecoded).
+#: What a flight's recorder reads (the rest of the vehicle's telemetry is dropped undecoded;
+#: pymavlink's ``recv_match`` takes a list or a set, and reads a frozenset as one type name).
 RECORDS = frozenset({"HEARTBEAT", "GLOBAL_POSITION_INT", "MISSION_ITEM_REACHED", "MISSION_CURRENT"})
 
 
@@ -223,7 +224,7 @@ def _fly(connection: str, px4: bool, first: int, last: int, budget_s: float, say
                     link.mav.command_long_send(target, 1, MAV_CMD_COMPONENT_ARM_DISARM, 0, 1,
                                                0, 0, 0, 0, 0, 0)
                 last_command = wall
-            message = link.recv_match(type=RECORDS, blocking=True, timeout=0.5)
+            message = link.recv_match(type=list(RECORDS), blocking=True, timeout=0.5)
             if message is None:
                 continue
             kind = message.get_type()
