@@ -132,6 +132,26 @@ def test_px4_defaults_to_a_landing_and_warns_about_rtl():
     assert not any(i.command == Command.NAV_LOITER_TURNS for i in rtl.items)
 
 
+def test_px4_says_when_it_will_fly_slower_than_asked():
+    from dataclasses import replace
+    from dtsp_mission.autopilot.parameters import PX4_DEFAULTS
+
+    def notes(asked: float, **vehicle) -> list[str]:
+        mission = make_mission(8, autopilot="px4", airspeed_m_s=asked, max_items=5000,
+                               vehicle=replace(PX4_DEFAULTS, **vehicle), design="geometry")
+        return [note for note in mission.notes if "PX4 will fly" in note]
+
+    # the SIH plane's own top speed (13.9 m/s true, 15 m/s as asked) binds below FW_AIRSPD_MAX
+    assert notes(18.0) == ["asked 18 m/s, PX4 will fly 15.0 m/s (PX4 SITL's SIH plane flies no "
+                           "faster than 13.9 m/s true airspeed): the mission is designed for the "
+                           "speed it flies"]
+    assert notes(15.0) == []
+    # a lower FW_AIRSPD_MAX binds first
+    assert notes(16.0, FW_AIRSPD_MAX=14.0) == [
+        "asked 16 m/s, PX4 will fly 14.0 m/s (its FW_AIRSPD_MAX (14 m/s)): the mission is "
+        "designed for the speed it flies"]
+
+
 @settings(max_examples=30)
 @given(count=st.integers(2, 12), seed=st.integers(0, 10_000), rho=st.sampled_from([20.0, 80.0, 300.0]),
        span=st.sampled_from([1.0, 100.0, 2000.0]), tolerance_fraction=st.sampled_from([0.005, 0.02, 0.2]))
