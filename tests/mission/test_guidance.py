@@ -53,6 +53,28 @@ def test_one_waypoint_per_target_and_every_target_predicted_within_the_limit(des
     assert mission.summary["predicted_flight_m"] == pytest.approx(mission.summary["planned_flight_m"], rel=0.08)
 
 
+def _aim_offsets_m(mission, targets, frame) -> np.ndarray:
+    items = [i for i in mission.items if i.role == "target"]
+    aims = frame.to_local(np.array([i.latitude_deg for i in items]),
+                          np.array([i.longitude_deg for i in items]))
+    at = targets.in_frame(frame).positions_m[[i.target for i in items]]
+    return np.hypot(*(aims - at).T)
+
+
+def test_a_capped_design_aims_no_target_farther_than_the_cap(designed):
+    """``DesignTuning.max_aim_offset_m``: the repair's corrections and the local repair's
+    moves keep each target's own waypoint within the cap (the default design aims farther)."""
+    mission, targets = designed
+    frame = LocalFrame(*CENTRE)
+    assert _aim_offsets_m(mission, targets, frame).max() > 4.0
+    tour, frame, targets = sparse_site()
+    settings = MissionSettings(altitude_m=120.0, airspeed_m_s=22.0, design="guidance",
+                               tuning=DesignTuning(max_aim_offset_m=2.0))
+    capped = build_mission(tour, frame, targets, settings)
+    assert _aim_offsets_m(capped, targets, frame).max() <= 2.0 + 0.02     # 1e-7 deg storage
+    assert max(capped.summary["predicted_miss_m"]) < 10.0
+
+
 def test_the_reported_flight_is_the_predicted_one_where_the_model_flew_it(designed):
     """The flight length and time plan reports (and sorties and --endurance use) are the
     model's flight from the take-off to the last target, the exact path before and after it:
