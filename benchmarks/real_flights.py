@@ -61,7 +61,12 @@ CODES = {"3177ef3": "3177ef3, before the real flights (the baseline)",
          "65f0ec6b": "3efe14e: the same design as c868f550 (the local repair's moves flown on both "
                      "cores)",
          "4448bf84": "9e377aa: one round of slow zones; PX4's SIH flown no faster than 13.9 m/s "
-                     "(the PX4 missions designed for it)"}
+                     "(the PX4 missions designed for it)",
+         "4f31b0bf": "6cf0426: the same design as 4448bf84",
+         "fb944b1d": "67112a6 with DesignTuning.max_aim_offset_m 15 (a trial: not the default)"}
+#: Digests of trials of design options that are not the default: listed beside the default's
+#: latest flight of the case, never as the case's result.
+TRIALS = {"fb944b1d": "aims within 15 m"}
 CSV_CASES = ROOT / "docs" / "real-flights.csv"
 CSV_TARGETS = ROOT / "docs" / "real-flights-targets.csv"
 RHO_M, ALTITUDE_M = 80.0, 120.0
@@ -275,6 +280,9 @@ def markdown(out: Path) -> None:
     with CSV_CASES.open() as handle:
         rows = list(csv.DictReader(handle))
     _filled_tour_times(rows)
+    trials = [row for row in rows if row["code"] in TRIALS]
+    every = rows
+    rows = [row for row in rows if row["code"] not in TRIALS]
     latest, runs, earlier = {}, {}, {}
     for row in rows:
         earlier.setdefault(row["case"], row)          # the first flight of the case
@@ -339,6 +347,24 @@ def markdown(out: Path) -> None:
                 lines.append(f"| {low:g}-{high:g} | {chosen.sum()} | "
                              f"{np.percentile(real[chosen], 95):.1f} | {real[chosen].max():.1f} | "
                              f"{(real[chosen] > 5).sum()} |")
+    if trials:
+        lines += ["", "## Design options flown beside the default", "",
+                  "The same case planned with an option of the design that is not the default "
+                  "(its code digest below), against the default's latest flight of the case "
+                  "(*option / default*).", "",
+                  "| case | option | beyond 5 m | real max m | model vs real p95 / max m "
+                  "| flown / tour | time / tour |", "|---|---|---|---|---|---|---|"]
+        for r in trials:
+            d = latest.get(r["case"])
+            if d is None:
+                continue
+            lines.append(f"| {r['case']} | {TRIALS[r['code']]} | {r['beyond_5m']} / "
+                         f"{d['beyond_5m']} | {float(r['real_max_m']):.1f} / "
+                         f"{float(d['real_max_m']):.1f} | {float(r['diff_p95_m']):.1f} / "
+                         f"{float(r['diff_max_m']):.1f} against {float(d['diff_p95_m']):.1f} / "
+                         f"{float(d['diff_max_m']):.1f} | {r['flown_over_tour']} / "
+                         f"{d['flown_over_tour']} | {r['time_over_tour']} / {d['time_over_tour']} |")
+    rows = every
     lines += ["", "## Every flight", "",
               "Code digests: " + "; ".join(f"`{k}` {v}" for k, v in CODES.items()) + ".", "",
               "| case | code | when | beyond 5 m | real max m | model vs real p95 / max m | flown / tour "

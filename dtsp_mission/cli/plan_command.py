@@ -13,7 +13,7 @@ import numpy as np
 from ..export import exporter_for
 from ..errors import DtspError
 from ..files import check_replaceable, write_together
-from ..mission import Autopilot, MissionSettings
+from ..mission import Autopilot, DesignTuning, MissionSettings
 from ..mission.widening import targets_beyond
 from ..mission.sorties import sortie_path
 from ..pipeline import PlanRequest, PlanResult, check_request, run_plan
@@ -164,6 +164,12 @@ def _duration(seconds: float) -> str:
                    "the tour. Repeatable; a 'loiter_turns' column does the same.")
 @click.option("--loiter-radius", "loiter_radius_m", type=LIMITS["distance"], metavar="METRES",
               help="Radius of the loiter circles (default 1.3 x the turn radius).")
+@click.option("--max-aim-offset", "max_aim_offset_m", type=LIMITS["distance"], metavar="METRES",
+              help="--design guidance: aim each target's waypoint no farther than this from it "
+                   "(default: as far as the design needs). Far aims hold targets through the "
+                   "guidance's modelled overshoot, which the real autopilot varies: 15 m lowered "
+                   "the real ArduPlane's misses on most sites flown, at the cost of longer "
+                   "flights on some (docs/missions.md).")
 @click.option("--simulate", is_flag=True, help="Fly the mission in the simulator (an ArduPlane "
               "with --vehicle-params, stock without) and print per-target miss distances.")
 @apply(simulation_options)
@@ -174,7 +180,7 @@ def plan(targets_file, random_count, area_file, seed, origin, rho_m, airspeed_m_
          return_mode, design, max_miss_m, wind_spread_m_s, tolerance_m, max_items, algorithm, region, time_limit_s,
          fallback, outputs, format_name,
          map_file, plot_file, connection, vehicle_connection, via, verify, signing_key_file, transfer_timeout_s, endurance_min,
-         photo, roi, gimbal_pitch_deg, loiter_specs, loiter_radius_m, simulate, speedup,
+         photo, roi, gimbal_pitch_deg, loiter_specs, loiter_radius_m, max_aim_offset_m, simulate, speedup,
          vehicle_params_file, l1_period_s, wind, quiet, as_json) -> None:
     """Plan a Dubins tour through the targets and write it as a mission.
 
@@ -230,7 +236,9 @@ def plan(targets_file, random_count, area_file, seed, origin, rho_m, airspeed_m_
             landing_bearing_deg=landing_bearing_deg, return_mode=return_mode, design=design,
             max_miss_m=max_miss_m, wind=wind, wind_spread_m_s=wind_spread_m_s,
             tolerance_m=tolerance_m, max_items=max_items, photo=photo, roi=roi,
-            gimbal_pitch_deg=gimbal_pitch_deg, loiter_radius_m=loiter_radius_m)
+            gimbal_pitch_deg=gimbal_pitch_deg, loiter_radius_m=loiter_radius_m,
+            tuning=(None if max_aim_offset_m is None
+                    else DesignTuning(max_aim_offset_m=max_aim_offset_m)))
         if autopilot == "px4" and any(writer.name == "waypoints" for _, writer in writers):
             note("a .waypoints file holds the home in its row 0, as QGroundControl, Mission "
                  "Planner and MAVProxy read it; a tool that sends every row would make it PX4's "

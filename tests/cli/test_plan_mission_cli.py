@@ -266,3 +266,29 @@ def test_plan_in_a_forecast_wind_reports_the_tour_for_that_wind_and_the_models_f
     assert summary["wind_tour_air_length_m"] == pytest.approx(22 * summary["wind_tour_time_s"])
     assert (summary["flight_length_m"] / 28 < summary["flight_time_s"]
             < summary["flight_length_m"] / 16)
+
+
+def test_max_aim_offset_keeps_each_target_s_waypoint_that_close(tmp_path):
+    """``--max-aim-offset``: every target has a waypoint within the cap (its own, aimed no
+    farther); without it the design aims some farther."""
+    from dtsp_mission.export import read_mission
+    from dtsp_mission.frame import LocalFrame
+    from dtsp_mission.targets import read_targets
+    targets_file = tmp_path / "t.csv"
+    targets_file.write_text("\n".join(SITE.read_text().splitlines()[:31]) + "\n")
+    targets = read_targets(str(targets_file))
+
+    def nearest_waypoint_m(*options) -> np.ndarray:
+        out = tmp_path / "m.plan"
+        result = run(str(targets_file), "--radius", "80", "--airspeed", "22", *options, "-o", str(out))
+        assert result.returncode == 0, result.stderr
+        mission = read_mission(str(out), None)
+        frame = LocalFrame(mission.home.latitude_deg, mission.home.longitude_deg)
+        waypoints = [i for i in mission.items if i.command == 16]
+        at = frame.to_local(np.array([i.latitude_deg for i in waypoints]),
+                            np.array([i.longitude_deg for i in waypoints]))
+        points = frame.to_local(targets.latitudes_deg, targets.longitudes_deg)
+        return np.array([np.hypot(*(at - p).T).min() for p in points])
+
+    assert nearest_waypoint_m().max() > 3.0
+    assert nearest_waypoint_m("--max-aim-offset", "3").max() <= 3.0 + 0.02
