@@ -207,8 +207,9 @@ class DesignTuning:
     #: 3,616 targets of 28 real ArduPlane flights (docs/real-flights.md): model and real
     #: differed by more than 3 m at 0.5 % of the targets aimed within 10 m, 2-3 % of those
     #: aimed 10-20 m away and 5-7 % of those aimed 20-50 m away.  15 m, flown again by the
-    #: real ArduPlane on eight cases: 27 -> 10 targets beyond 5 m; off by default, as the
-    #: bundled site then flies 1.32 instead of 1.08 x its tour (docs/missions.md).
+    #: real ArduPlane on ten cases: 29 -> 10 targets beyond 5 m, flights as long on average;
+    #: off by default, as the bundled site then flies 1.32 instead of 1.08 x its tour and
+    #: takes 2.5 times as long to plan (docs/missions.md).
     max_aim_offset_m: float | None = None
     #: ... for the targets judged beyond the limit less this much (held, but by less than the
     #: real autopilot's flight-to-flight spread), kept if their cost at that tighter limit falls
