@@ -63,10 +63,13 @@ CODES = {"3177ef3": "3177ef3, before the real flights (the baseline)",
          "4448bf84": "9e377aa: one round of slow zones; PX4's SIH flown no faster than 13.9 m/s "
                      "(the PX4 missions designed for it)",
          "4f31b0bf": "6cf0426: the same design as 4448bf84",
-         "fb944b1d": "67112a6 with DesignTuning.max_aim_offset_m 15 (a trial: not the default)"}
+         "fb944b1d": "67112a6 with DesignTuning.max_aim_offset_m 15 (a trial: not the default)",
+         "c0bfd9c1": "d394d2b with the 15 m cap in the repair's corrections only, the local "
+                     "repair's moves free (a trial: not the default)"}
 #: Digests of trials of design options that are not the default: listed beside the default's
 #: latest flight of the case, never as the case's result.
-TRIALS = {"fb944b1d": "aims within 15 m"}
+TRIALS = {"fb944b1d": "aims within 15 m",
+          "c0bfd9c1": "corrections within 15 m"}
 CSV_CASES = ROOT / "docs" / "real-flights.csv"
 CSV_TARGETS = ROOT / "docs" / "real-flights-targets.csv"
 RHO_M, ALTITUDE_M = 80.0, 120.0
