@@ -64,7 +64,7 @@ CODES = {"3177ef3": "3177ef3, before the real flights (the baseline)",
                      "(the PX4 missions designed for it)",
          "4f31b0bf": "6cf0426: the same design as 4448bf84",
          "fb944b1d": "67112a6 with DesignTuning.max_aim_offset_m 15 (a trial: not the default)",
-         "c0bfd9c1": "d394d2b with the 15 m cap in the repair's corrections only, the local "
+         "c0bfd9c1": "da5baf5 with the 15 m cap in the repair's corrections only, the local "
                      "repair's moves free (a trial: not the default)"}
 #: Digests of trials of design options that are not the default: listed beside the default's
 #: latest flight of the case, never as the case's result.
