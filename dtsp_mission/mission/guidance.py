@@ -543,6 +543,13 @@ def _refine(aim: np.ndarray, target_of: list[int], items: list[LocalItem], seqs:
         cost = _Trial.cost_of(miss, max_miss_m, tuning.beyond_cost)
         return marks, miss, runs[0].measured_length_m, cost
 
+    def within_cap(j: int, point: np.ndarray) -> np.ndarray:
+        """``point`` for waypoint ``j``: no farther from its target than the cap."""
+        own = target_of[j]
+        if own < 0 or tuning.max_aim_offset_m is None:
+            return point
+        return targets_m[own] + _capped(point - targets_m[own], tuning.max_aim_offset_m)
+
     marks, miss, length, cost = afresh(mission)
     flights = 1
     aim = aim.copy()
@@ -625,13 +632,6 @@ def _refine(aim: np.ndarray, target_of: list[int], items: list[LocalItem], seqs:
                     else:
                         step_m *= 0.5
                 return candidate, current
-
-            def within_cap(j: int, point: np.ndarray) -> np.ndarray:
-                """``point`` for waypoint ``j``: no farther from its target than the cap."""
-                own = target_of[j]
-                if own < 0 or tuning.max_aim_offset_m is None:
-                    return point
-                return targets_m[own] + _capped(point - targets_m[own], tuning.max_aim_offset_m)
 
             first_step_m = max(min(miss[t] - max_miss_m, 10.0), 1.0)
             leading = [0]           # the wind whose misses weighed most in the last full trial

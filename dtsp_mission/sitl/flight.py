@@ -191,6 +191,7 @@ def _fly(connection: str, px4: bool, first: int, last: int, budget_s: float, say
     """Set AUTO until it holds, arm, and record until ``last`` is reached (plus
     :data:`AFTER_LAST_S`); returns rows (time, lat, lon, height) and reach times by seq."""
     link = _link(connection, RECORDS)
+    records = list(RECORDS)
     rows: list[tuple[float, float, float, float]] = []
     reached: dict[int, float] = {}
     now_s = 0.0
@@ -224,7 +225,7 @@ def _fly(connection: str, px4: bool, first: int, last: int, budget_s: float, say
                     link.mav.command_long_send(target, 1, MAV_CMD_COMPONENT_ARM_DISARM, 0, 1,
                                                0, 0, 0, 0, 0, 0)
                 last_command = wall
-            message = link.recv_match(type=list(RECORDS), blocking=True, timeout=0.5)
+            message = link.recv_match(type=records, blocking=True, timeout=0.5)
             if message is None:
                 continue
             kind = message.get_type()
