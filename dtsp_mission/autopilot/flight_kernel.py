@@ -85,7 +85,9 @@ A_BANK_SPEED = 29
 # ArduPlane's TECS: how fast its airspeed demand moves to a new target (m/s^2 up and down; 0:
 # at once).  Only where the airspeed follows a change at once (A_SPEED_TC 0).
 A_SPEED_UP, A_SPEED_DOWN = 30, 31
-AIRFRAME_SIZE = 32
+# The most roll rate the roll controller asks for (rad/s; ArduPlane's RLL2SRV_RMAX; 0: none).
+A_ROLL_RATE_MAX = 32
+AIRFRAME_SIZE = 33
 
 LOITER_EXIT_HEADING_RAD = math.radians(10.0)
 TWO_PI = 2.0 * math.pi
@@ -345,7 +347,15 @@ def _fly(st, af, dt, lateral_accel, climb_rate, ground_factor):
     limit = math.radians(af[A_ROLL_LIMIT])
     command = _clip(math.atan(lateral_accel / G), -limit, limit)
     w, z = af[A_ROLL_W], af[A_ROLL_Z]
-    st[S_BANK_RATE] += (w * w * (command - st[S_BANK]) - 2 * z * w * st[S_BANK_RATE]) * dt
+    # The second-order roll response is the roll controller's: a roll rate asked for in
+    # proportion to the bank error (w / 2z per second), followed with a lag of 1 / 2zw; the
+    # rate asked for is limited (RLL2SRV_RMAX), which slows the large reversals.
+    asked = w / (2.0 * z) * (command - st[S_BANK])
+    limit_rate = af[A_ROLL_RATE_MAX]
+    if limit_rate > 0.0 and abs(asked) > limit_rate:
+        st[S_BANK_RATE] += 2.0 * z * w * (math.copysign(limit_rate, asked) - st[S_BANK_RATE]) * dt
+    else:
+        st[S_BANK_RATE] += (w * w * (command - st[S_BANK]) - 2 * z * w * st[S_BANK_RATE]) * dt
     st[S_BANK] = _clip(st[S_BANK] + st[S_BANK_RATE] * dt, -limit, limit)
     air = airspeed * ground_factor
     turn_rate = turn_rate_rad_s(airspeed, st[S_BANK], af[A_TURN_EFFICIENCY])

@@ -50,6 +50,8 @@ class VehicleParameters(_NamedValues):
     RTL_ALTITUDE: float = 100.0       # m
     RTL_RADIUS: float = 0.0           # m, 0: WP_LOITER_RAD
     SCHED_LOOP_RATE: float = 50.0     # Hz, the main loop (navigation runs in it)
+    RLL2SRV_RMAX: float = 90.0        # deg/s, the most roll rate asked for (0: no limit;
+                                      # ArduPlane SITL's stock plane.parm: 90)
 
     def l1_distance_m(self, speed_m_s: float) -> float:
         """ArduPlane's L1 distance at this ground speed."""
@@ -68,7 +70,7 @@ RANGES: dict[str, tuple[float, float]] = {
     "ROLL_LIMIT_DEG": (10.0, 90.0), "TECS_CLMB_MAX": (0.1, 20.0), "TECS_SINK_MAX": (0.1, 20.0),
     "TECS_TIME_CONST": (3.0, 10.0), "TKOFF_LVL_PITCH": (0.0, 30.0),
     "RTL_ALTITUDE": (-1.0, 32767.0), "RTL_RADIUS": (-32767.0, 32767.0),
-    "SCHED_LOOP_RATE": (50.0, 400.0),
+    "SCHED_LOOP_RATE": (50.0, 400.0), "RLL2SRV_RMAX": (0.0, 180.0),
 }
 
 
