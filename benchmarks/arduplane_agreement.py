@@ -50,8 +50,10 @@ stored it, with the case's recorded `params.parm` and its wind (`SIM_WIND_SPD`,
 
 Goals: timing within 2 s, track within 3 m (median) and 10 m (max), closest approach within
 1 m (median) and 3 m (max); the last column names those a case misses. What the model takes
-from the recordings (each fitted once, on all cases): the roll response (4.4 rad/s, damping
-0.6), the turn rate of the SITL airframe at 0.70 of the coordinated-turn rate for its bank at
+from the recordings (each fitted once, on all cases): the roll response (a roll rate asked for
+in proportion to the bank error and limited to 1.5 x `RLL2SRV_RMAX`, followed with a lag: 4.4
+rad/s, damping 0.5, 135 deg/s on the stock plane; fitted together with the real flights of the
+project's own missions, `docs/real-flights.md`), the turn rate of the SITL airframe at 0.70 of the coordinated-turn rate for its bank at
 the airspeed it flies in that bank (1 m/s faster per unit of 1 / cos(bank) - 1: 22.3-22.9 m/s at
 45-55 deg in the recordings),
 the take-off run (5.3 m/s^2, lift-off at 85 % of the cruise airspeed) and climb, and the
