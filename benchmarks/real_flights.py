@@ -65,7 +65,9 @@ CODES = {"3177ef3": "3177ef3, before the real flights (the baseline)",
          "4f31b0bf": "6cf0426: the same design as 4448bf84",
          "fb944b1d": "67112a6 with DesignTuning.max_aim_offset_m 15 (a trial: not the default)",
          "c0bfd9c1": "da5baf5 with the 15 m cap in the repair's corrections only, the local "
-                     "repair's moves free (a trial: not the default)"}
+                     "repair's moves free (a trial: not the default)",
+         "fad7332d": "4f08efb: the model's roll rate limited (RLL2SRV_RMAX), its roll response "
+                     "refitted with it"}
 #: Digests of trials of design options that are not the default: listed beside the default's
 #: latest flight of the case, never as the case's result.
 TRIALS = {"fb944b1d": "aims within 15 m",

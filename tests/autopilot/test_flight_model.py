@@ -4,11 +4,13 @@ analytic cases (its agreement with real ArduPlane flights is ``test_agreement.py
 from __future__ import annotations
 
 import math
+from dataclasses import replace
 
 import numpy as np
 import pytest
 
 from dtsp_mission.autopilot import Command
+from dtsp_mission.autopilot.parameters import ARDUPLANE_DEFAULTS
 from dtsp_mission.autopilot.navigation import (CALM, Airframe, LocalItem, MissionFlight, Wind,
                                                check_wind, closest_approach_m)
 from dtsp_mission.errors import InputError
@@ -179,3 +181,43 @@ def test_a_px4_loiter_holds_its_circle_for_its_time(wind):
     radius = np.hypot(loop[:, 1] - 900.0, loop[:, 2])
     assert np.abs(radius - 90.0).max() < (1.0 if wind == CALM else 2.0), (radius.min(), radius.max())
     assert 120.0 < times[3] - times[2] < 120.0 + 2 * math.pi * 90.0 / 10.0   # its time, from the circle
+
+
+def _roll_history(airframe: Airframe, from_deg: float, to_deg: float, seconds: float = 2.0):
+    """The bank (deg) of the model's roll response, step by step (0.01 s), from a steady bank
+    of ``from_deg`` asked to roll to ``to_deg``."""
+    from dtsp_mission.autopilot import flight_kernel as K
+    from dtsp_mission.autopilot.navigation import airframe_vector
+    af = airframe_vector(airframe)
+    st = np.zeros(K.STATE_SIZE)
+    st[K.S_AIRSPEED] = airframe.airspeed_m_s
+    st[K.S_BANK] = math.radians(from_deg)
+    st[K.S_COS_HEADING] = 1.0
+    demand = K.G * math.tan(math.radians(to_deg))
+    banks = []
+    for _ in range(int(seconds / 0.01)):
+        K._fly(st, af, 0.01, demand, 0.0, 1.0)
+        banks.append(math.degrees(st[K.S_BANK]))
+    return np.array(banks)
+
+
+def test_a_large_roll_reversal_is_no_faster_than_the_roll_rate_limit():
+    """ArduPlane's roll controller asks for at most RLL2SRV_RMAX: the model's reversal from
+    40 deg one way to 40 deg the other is limited to 1.5 x RLL2SRV_RMAX (its fitted share),
+    where the second-order lag alone would roll far faster; a small step is the same with the
+    limit as without (the limit is not reached)."""
+    limited = SHIPPED
+    free = Airframe.from_parameters(replace(ARDUPLANE_DEFAULTS, RLL2SRV_RMAX=0.0), 22.0)
+    assert limited.roll_rate_max_deg_s == pytest.approx(135.0) and free.roll_rate_max_deg_s == 0.0
+    reversal = _roll_history(limited, -40.0, 40.0, seconds=4.0)
+    rate = np.diff(reversal) / 0.01
+    assert rate.max() <= 135.0 + 1e-6 and rate.max() > 120.0
+    free_rate = np.diff(_roll_history(free, -40.0, 40.0)) / 0.01
+    assert free_rate.max() > 180.0
+    # both end on the new bank
+    assert reversal[-1] == pytest.approx(40.0, abs=0.5)
+    # a small step does not reach the limit: the same response, step for step
+    np.testing.assert_array_equal(_roll_history(limited, 0.0, 5.0), _roll_history(free, 0.0, 5.0))
+    # a vehicle's own limit is read from its parameters
+    slow = Airframe.from_parameters(replace(ARDUPLANE_DEFAULTS, RLL2SRV_RMAX=60.0), 22.0)
+    assert np.diff(_roll_history(slow, -40.0, 40.0)).max() / 0.01 <= 90.0 + 1e-6
