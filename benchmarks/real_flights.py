@@ -67,7 +67,11 @@ CODES = {"3177ef3": "3177ef3, before the real flights (the baseline)",
          "c0bfd9c1": "da5baf5 with the 15 m cap in the repair's corrections only, the local "
                      "repair's moves free (a trial: not the default)",
          "fad7332d": "4f08efb: the model's roll rate limited (RLL2SRV_RMAX), its roll response "
-                     "refitted with it"}
+                     "refitted with it",
+         "a5ab03ce": "the design guarded against flipped outcomes (DesignTuning.flip_*): the "
+                     "same design as e5d9e3a3 (a step: its docstring before the figures)",
+         "e5d9e3a3": "4383e3b: the model's roll rate limited, the design guarded against flipped "
+                     "outcomes"}
 #: Digests of trials of design options that are not the default: listed beside the default's
 #: latest flight of the case, never as the case's result.
 TRIALS = {"fb944b1d": "aims within 15 m",
