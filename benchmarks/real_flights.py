@@ -71,7 +71,9 @@ CODES = {"3177ef3": "3177ef3, before the real flights (the baseline)",
          "a5ab03ce": "the design guarded against flipped outcomes (DesignTuning.flip_*): the "
                      "same design as e5d9e3a3 (a step: its docstring before the figures)",
          "e5d9e3a3": "4383e3b: the model's roll rate limited, the design guarded against flipped "
-                     "outcomes"}
+                     "outcomes",
+         "d8c7946b": "the same designs as e5d9e3a3 byte for byte (a review: the slower-roll aircraft "
+                     "made in one place, the roll limit's arithmetic only where it applies)"}
 #: Digests of trials of design options that are not the default: listed beside the default's
 #: latest flight of the case, never as the case's result.
 TRIALS = {"fb944b1d": "aims within 15 m",

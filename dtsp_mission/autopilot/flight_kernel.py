@@ -350,9 +350,9 @@ def _fly(st, af, dt, lateral_accel, climb_rate, ground_factor):
     # The second-order roll response is the roll controller's: a roll rate asked for in
     # proportion to the bank error (w / 2z per second), followed with a lag of 1 / 2zw; the
     # rate asked for is limited (RLL2SRV_RMAX), which slows the large reversals.
-    asked = w / (2.0 * z) * (command - st[S_BANK])
     limit_rate = af[A_ROLL_RATE_MAX]
-    if limit_rate > 0.0 and abs(asked) > limit_rate:
+    asked = w / (2.0 * z) * (command - st[S_BANK]) if limit_rate > 0.0 else 0.0
+    if abs(asked) > limit_rate > 0.0:
         st[S_BANK_RATE] += 2.0 * z * w * (math.copysign(limit_rate, asked) - st[S_BANK_RATE]) * dt
     else:
         st[S_BANK_RATE] += (w * w * (command - st[S_BANK]) - 2 * z * w * st[S_BANK_RATE]) * dt

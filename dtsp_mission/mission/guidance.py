@@ -500,16 +500,19 @@ def _conditions(airframe: Airframe, winds: tuple[Wind, ...],
                                                                                tuning.turn_spread)),
                    winds[0]) for sign in (-1.0, 1.0)]
     if tuning.roll_spread > 0 or tuning.roll_damping_spread > 0:
-        flown.append((replace(airframe,
-                              roll_natural_rad_s=airframe.roll_natural_rad_s * (1.0 - tuning.roll_spread),
-                              roll_damping=airframe.roll_damping + tuning.roll_damping_spread),
+        flown.append((rolling_slower(airframe, tuning.roll_spread, tuning.roll_damping_spread),
                       winds[0]))
     if _flips(tuning):
-        flown.append((replace(airframe, roll_natural_rad_s=airframe.roll_natural_rad_s
-                              * (1.0 - tuning.flip_roll_spread),
-                              roll_damping=airframe.roll_damping + tuning.flip_roll_damping_spread),
-                      winds[0]))
+        flown.append((rolling_slower(airframe, tuning.flip_roll_spread,
+                                     tuning.flip_roll_damping_spread), winds[0]))
     return flown
+
+
+def rolling_slower(airframe: Airframe, spread: float, damping_spread: float) -> Airframe:
+    """``airframe`` with its roll response's natural frequency times ``1 - spread`` and its
+    damping plus ``damping_spread``."""
+    return replace(airframe, roll_natural_rad_s=airframe.roll_natural_rad_s * (1.0 - spread),
+                   roll_damping=airframe.roll_damping + damping_spread)
 
 
 def _flips(tuning: DesignTuning) -> int:

@@ -606,11 +606,11 @@ def _slow_roll_misses_m(mission) -> tuple[np.ndarray, list[int]]:
     """The written mission flown again from the start by the stock aircraft at 22 m/s rolling
     much slower (DesignTuning's flip guard: roll response 40 % slower, damping +0.3): its miss
     at each target waypoint, and the target each is for."""
+    from dtsp_mission.mission.guidance import rolling_slower
     from dtsp_mission.sim.fly import planned_targets
-    stock = Airframe.from_parameters(airspeed_m_s=22.0)
     tuning = DesignTuning()
-    slow = replace(stock, roll_natural_rad_s=stock.roll_natural_rad_s * (1 - tuning.flip_roll_spread),
-                   roll_damping=stock.roll_damping + tuning.flip_roll_damping_spread)
+    slow = rolling_slower(Airframe.from_parameters(airspeed_m_s=22.0), tuning.flip_roll_spread,
+                          tuning.flip_roll_damping_spread)
     flown = predict_flight(mission.for_vehicle(), slow)
     passed = planned_targets(mission)
     miss = closest_approach_m(flown.track[:, 1:3],
