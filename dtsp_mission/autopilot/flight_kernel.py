@@ -440,6 +440,15 @@ def _complete(st, af, command, position, params, reached, counts, leg_x, leg_y, 
     st[S_LOITER] = 0.0
     st[S_RUN] = 0.0
     _skip_instant_items(st, af, command, params, reached, counts)
+    k = int(st[S_INDEX])
+    if (af[A_PX4] <= 0.0 and k < len(command) and command[k] == NAV_WAYPOINT
+            and not math.isnan(position[k, 0])):
+        # ArduPlane's set_next_WP: already past the new waypoint's finish line where the leg
+        # starts, the leg starts here instead (else the waypoint would count as passed at once)
+        ax, ay = st[S_PREV_X], st[S_PREV_Y]
+        bx, by = position[k, 0], position[k, 1]
+        if (st[S_X] - bx) * (bx - ax) + (st[S_Y] - by) * (by - ay) > 0.0:
+            st[S_PREV_X], st[S_PREV_Y], st[S_PREV_ALT] = st[S_X], st[S_Y], st[S_ALT]
 
 
 @numba.njit(**_JIT)
