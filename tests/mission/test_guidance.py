@@ -595,9 +595,19 @@ def test_the_design_is_the_same_on_one_core_and_on_several():
     import sys
     from pathlib import Path
     tests = str(Path(__file__).resolve().parents[1])
-    results = [subprocess.run([sys.executable, "-c", _ONE_DESIGN.format(tests=tests, one_core=one)],
-                              capture_output=True, text=True, timeout=300, check=True).stdout.split()
+    # both at once: the one pinned to one core, the other on all of them
+    running = [subprocess.Popen([sys.executable, "-c", _ONE_DESIGN.format(tests=tests, one_core=one)],
+                                stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True)
                for one in (True, False)]
+    results = []
+    try:
+        for process in running:
+            out, err = process.communicate(timeout=300)
+            assert process.returncode == 0, err
+            results.append(out.split())
+    finally:
+        for process in running:
+            process.kill()
     assert results[0] == results[1]
     assert int(results[0][1]) > 0
 
