@@ -297,25 +297,22 @@ def test_the_turn_margin_keeps_a_design_that_holds_and_otherwise_ranks_by_the_fl
 
 
 @pytest.mark.heavy(seconds=29)
-def test_the_local_repair_s_other_starts_are_deterministic_and_never_hold_fewer_first():
+def test_the_local_repair_s_other_starts_are_deterministic():
     """After one repair round on the fence (forecast wind only), the local repair's pattern
-    search leaves a post beyond the design limit; 100 seeded random starts (off by default)
-    leave no more, and the same input gives the same mission.  (A heuristic that no longer
-    pays: with the take-off flown where the vehicle stores it, over 1-4 rounds the search alone
-    leaves 1 post beyond and with the starts 1, 3, 3, 3; it held every post before.)"""
-    from dtsp_mission.mission.widening import targets_beyond as beyond
+    search leaves posts beyond the design limit; 100 seeded random starts (off by default) give
+    the same mission for the same input.  (A heuristic that no longer pays: with the take-off
+    flown where the vehicle stores it, over 1-4 rounds the search alone left 1 post beyond and
+    with the starts 1, 3, 3, 3; since the model flies to a waypoint whose leg starts already
+    past it, as ArduPlane does, one round leaves 2 alone and 5 with the starts.)"""
     tour, frame, targets = _fence(80.0)
     # (judged as measured: the turn spread of then, no slower roll, no slow zones)
     then = dict(rounds=1, revisits=False, slow_rounds=0, turn_spread=0.04, roll_spread=0.0,
                 roll_damping_spread=0.0, perturbed_holdback_m=0.0)
     settings = MissionSettings(design="guidance", airspeed_m_s=22.0, altitude_m=120.0,
-                               wind_spread_m_s=0.0, tuning=DesignTuning(**then))
-    alone = build_mission(tour, frame, targets, settings)
-    assert beyond(alone) > 0
-    settings = replace(settings, tuning=DesignTuning(local_starts=100, **then))
+                               wind_spread_m_s=0.0, tuning=DesignTuning(local_starts=100, **then))
     started = build_mission(tour, frame, targets, settings)
     assert build_mission(tour, frame, targets, settings).items == started.items
-    assert beyond(started) <= beyond(alone)
+    assert started.guidance.design_rounds > 1
 
 
 def _flown_again_off_the_report_m(mission) -> float:
@@ -409,14 +406,18 @@ def test_a_mission_designed_for_the_wind_holds_in_it_what_a_calm_design_misses()
 
 @pytest.mark.heavy(seconds=40)
 def test_a_target_left_beyond_is_passed_again_later_and_held(clustered_stuck):
-    """On the clustered site of the test above, without the second search the design leaves a
-    target beyond its limit; with revisits each such target is passed a second time later in
+    """On another clustered site (seed 5), without the second search the design leaves targets
+    beyond its limit (5 today); with revisits each such target is passed a second time later in
     the mission -- one waypoint over it, at its altitude and acceptance radius -- which brings
-    it closer (here not within the limit: revisits are a heuristic, kept only when the robust
-    cost falls), and the written mission, flown again from the start, passes the targets as
-    the design reports."""
+    them closer (1 left beyond: revisits are a heuristic, kept only when the robust cost falls;
+    on the site of the test above they no longer lower it, since the model flies to a waypoint
+    whose leg starts already past it as ArduPlane does), and the written mission, flown again
+    from the start, passes the targets as the design reports."""
+    from dtsp_mission.api import plan_tour
     from dtsp_mission.mission.widening import targets_beyond as beyond
-    tour, frame, targets, settings, _ = clustered_stuck
+    settings = clustered_stuck[3]
+    targets = _clustered(80, 5)
+    tour, frame = plan_tour(targets, 80.0)
     # judged by the forecast and the design winds only (as measured; with the turn spread the
     # revisit does not lower the robust cost here and is not kept;
     # and with no slow zones, which hold it on the first pass)
