@@ -60,7 +60,9 @@ S_COS_HEADING, S_SIN_HEADING = 27, 28               # cos and sin of S_HEADING, 
 S_TKO_EXCESS, S_TKO_END = 29, 30                    # airspeed over the target left by the climb-out,
                                                     # and when the take-off ended
 S_SPEED_HELD = 31                                   # the airspeed demand on its way to the target
-STATE_SIZE = 32
+S_DIRECT = 32                                       # 1: ArduPlane flies to the waypoint without
+                                                    # cross-tracking (the leg after a take-off)
+STATE_SIZE = 33
 
 # -- the airframe vector -----------------------------------------------------------------------
 (A_AIRSPEED, A_L1_PERIOD, A_WP_RADIUS, A_ROLL_W, A_ROLL_Z, A_L1_DAMPING,
@@ -439,6 +441,9 @@ def _complete(st, af, command, position, params, reached, counts, leg_x, leg_y, 
     st[S_INDEX] = i + 1
     st[S_LOITER] = 0.0
     st[S_RUN] = 0.0
+    # ArduPlane does not cross-track on the leg after a take-off: its L1 law flies from where
+    # the aircraft is, every navigation tick, straight to the waypoint
+    st[S_DIRECT] = 1.0 if c == NAV_TAKEOFF and af[A_PX4] <= 0.0 else 0.0
     _skip_instant_items(st, af, command, params, reached, counts)
     k = int(st[S_INDEX])
     if (af[A_PX4] <= 0.0 and k < len(command) and command[k] == NAV_WAYPOINT
@@ -622,6 +627,8 @@ def step(st, af, command, position, params, following, reached, counts, dt):
     if tick:
         if px4:
             st[S_DEMAND] = _npfg_lateral_accel(st, af, ax, ay, bx, by)
+        elif st[S_DIRECT] != 0.0:
+            st[S_DEMAND] = _l1_lateral_accel(st, af, st[S_X], st[S_Y], bx, by)
         else:
             st[S_DEMAND] = _l1_lateral_accel(st, af, ax, ay, bx, by)
     _fly(st, af, dt, st[S_DEMAND], climb, 1.0)
