@@ -73,11 +73,18 @@ CODES = {"3177ef3": "3177ef3, before the real flights (the baseline)",
          "e5d9e3a3": "4383e3b: the model's roll rate limited, the design guarded against flipped "
                      "outcomes",
          "d8c7946b": "the same designs as e5d9e3a3 byte for byte (a review: the slower-roll aircraft "
-                     "made in one place, the roll limit's arithmetic only where it applies)"}
+                     "made in one place, the roll limit's arithmetic only where it applies)",
+         "04284164": "7adc74c: the model flies to a waypoint whose leg starts already past it "
+                     "(ArduPlane's set_next_WP)",
+         "db7151b6": "199f907: and no cross-track on the leg after a take-off (ArduPlane's "
+                     "verify_takeoff)",
+         "ba1d51b7": "7adc74c without the flip guard (DesignTuning.flip_* 0; a trial: not the "
+                     "default)"}
 #: Digests of trials of design options that are not the default: listed beside the default's
 #: latest flight of the case, never as the case's result.
 TRIALS = {"fb944b1d": "aims within 15 m",
-          "c0bfd9c1": "corrections within 15 m"}
+          "c0bfd9c1": "corrections within 15 m",
+          "ba1d51b7": "no flip guard"}
 CSV_CASES = ROOT / "docs" / "real-flights.csv"
 CSV_TARGETS = ROOT / "docs" / "real-flights-targets.csv"
 RHO_M, ALTITUDE_M = 80.0, 120.0
