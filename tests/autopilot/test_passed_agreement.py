@@ -11,10 +11,9 @@ import pytest
 
 from dtsp_mission.autopilot.commands import Command
 from dtsp_mission.autopilot.navigation import Airframe, closest_approach_m
-from dtsp_mission.frame import LocalFrame
 from dtsp_mission.sim.predict import predict_flight
 
-from .recorded import read_recorded
+from .recorded import read_recorded, waypoints_m
 
 DATA = Path(__file__).resolve().parents[1] / "data" / "arduplane-sitl-passed"
 #: the waypoints (seq) already passed when their legs start, and the seq before each
@@ -24,12 +23,8 @@ PASSED = {5: 4, 9: 8, 12: 11}
 @pytest.fixture(scope="module")
 def flights():
     mission, track, reached = read_recorded(DATA)
-    frame = LocalFrame(mission.home.latitude_deg, mission.home.longitude_deg)
-    waypoints = [item for item in mission.items if int(item.command) == Command.NAV_WAYPOINT]
-    points = frame.to_local(np.array([w.latitude_deg for w in waypoints]),
-                            np.array([w.longitude_deg for w in waypoints]))
     model = predict_flight(mission, Airframe())
-    return mission, track, reached, model.track, dict(model.reached), points
+    return mission, track, reached, model.track, dict(model.reached), waypoints_m(mission)
 
 
 def test_a_waypoint_already_passed_when_its_leg_starts_is_flown_to(flights):

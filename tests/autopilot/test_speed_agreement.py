@@ -11,11 +11,9 @@ import numpy as np
 import pytest
 
 from dtsp_mission.autopilot.navigation import Airframe, closest_approach_m
-from dtsp_mission.autopilot.commands import Command
-from dtsp_mission.frame import LocalFrame
 from dtsp_mission.sim.predict import predict_flight
 
-from .recorded import read_recorded
+from .recorded import read_recorded, waypoints_m
 
 DATA = Path(__file__).resolve().parents[1] / "data" / "arduplane-sitl-speed"
 
@@ -23,11 +21,7 @@ DATA = Path(__file__).resolve().parents[1] / "data" / "arduplane-sitl-speed"
 @pytest.fixture(scope="module")
 def recorded():
     mission, track, reached = read_recorded(DATA)
-    frame = LocalFrame(mission.home.latitude_deg, mission.home.longitude_deg)
-    waypoints = [item for item in mission.items if int(item.command) == Command.NAV_WAYPOINT]
-    points = frame.to_local(np.array([w.latitude_deg for w in waypoints]),
-                            np.array([w.longitude_deg for w in waypoints]))
-    return mission, track, reached, points
+    return mission, track, reached, waypoints_m(mission)
 
 
 def _speed_at(track: np.ndarray, north_m: float) -> float:
