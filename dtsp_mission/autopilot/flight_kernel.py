@@ -441,12 +441,13 @@ def _complete(st, af, command, position, params, reached, counts, leg_x, leg_y, 
     st[S_INDEX] = i + 1
     st[S_LOITER] = 0.0
     st[S_RUN] = 0.0
+    ardupilot = af[A_PX4] <= 0.0
     # ArduPlane does not cross-track on the leg after a take-off: its L1 law flies from where
     # the aircraft is, every navigation tick, straight to the waypoint
-    st[S_DIRECT] = 1.0 if c == NAV_TAKEOFF and af[A_PX4] <= 0.0 else 0.0
+    st[S_DIRECT] = 1.0 if c == NAV_TAKEOFF and ardupilot else 0.0
     _skip_instant_items(st, af, command, params, reached, counts)
     k = int(st[S_INDEX])
-    if (af[A_PX4] <= 0.0 and k < len(command) and command[k] == NAV_WAYPOINT
+    if (ardupilot and k < len(command) and command[k] == NAV_WAYPOINT
             and not math.isnan(position[k, 0])):
         # ArduPlane's set_next_WP: already past the new waypoint's finish line where the leg
         # starts, the leg starts here instead (else the waypoint would count as passed at once)
@@ -627,7 +628,7 @@ def step(st, af, command, position, params, following, reached, counts, dt):
     if tick:
         if px4:
             st[S_DEMAND] = _npfg_lateral_accel(st, af, ax, ay, bx, by)
-        elif st[S_DIRECT] != 0.0:
+        elif st[S_DIRECT] != 0.0:         # from where the aircraft is (no cross-track)
             st[S_DEMAND] = _l1_lateral_accel(st, af, st[S_X], st[S_Y], bx, by)
         else:
             st[S_DEMAND] = _l1_lateral_accel(st, af, ax, ay, bx, by)
