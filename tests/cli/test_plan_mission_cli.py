@@ -29,7 +29,7 @@ def run(*arguments):
                           capture_output=True, text=True, timeout=900)
 
 
-@pytest.mark.heavy(seconds=320)
+@pytest.mark.heavy(seconds=35)
 def test_site_example_to_every_format_and_a_plot_designed_for_a_stock_ardupilot(tmp_path):
     """The README's quick start (more formats): the guidance design fits the site in a stock
     ArduPlane, one waypoint per target, and the report says what it predicts."""

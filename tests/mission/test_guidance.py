@@ -563,17 +563,17 @@ def test_a_tour_with_lead_ins_is_designed_with_a_waypoint_where_each_straight_be
 
 
 _ONE_DESIGN = """
-import hashlib, os, sys
-import os
-from dataclasses import replace
+import hashlib, os, pickle, sys
 sys.path.insert(0, {tests!r})
 from mission.test_guidance import _clustered, CENTRE
-from dtsp_mission.api import plan_tour
+from dtsp_mission.frame import LocalFrame
 from dtsp_mission.mission import DesignTuning, MissionSettings, build_mission
 if {one_core}:
     os.sched_setaffinity(0, {{min(os.sched_getaffinity(0))}})
 targets = _clustered(80, 2)
-tour, frame = plan_tour(targets, 80.0)
+with open({tour!r}, "rb") as file:
+    tour, origin = pickle.load(file)
+frame = LocalFrame(*origin)
 settings = MissionSettings(design="guidance", airspeed_m_s=22.0, altitude_m=120.0,
                            home_deg=CENTRE, wind_spread_m_s=0.0,
                            tuning=DesignTuning(revisits=False, slow_rounds=0))
@@ -584,20 +584,25 @@ print(hashlib.sha256(repr([(i.command, i.latitude_deg, i.longitude_deg, i.params
 """
 
 
-@pytest.mark.heavy(seconds=60)
+@pytest.mark.heavy(seconds=8)
 @pytest.mark.skipif(not hasattr(os, "sched_getaffinity") or len(os.sched_getaffinity(0)) < 2,
                     reason="needs two cores to compare with one")
-def test_the_design_is_the_same_on_one_core_and_on_several():
+def test_the_design_is_the_same_on_one_core_and_on_several(clustered_stuck, tmp_path):
     """The design flies its trials on every core (the local repair's moves of a step, the
     conditions of a trial): what it chooses does not depend on the machine -- the mission
     designed pinned to one core is item for item the one designed on all of them (the clustered
-    site whose local repair has targets to work on)."""
+    site whose local repair has targets to work on; its tour planned once, by the fixture)."""
+    import pickle
     import subprocess
     import sys
     from pathlib import Path
     tests = str(Path(__file__).resolve().parents[1])
+    tour, frame = clustered_stuck[:2]
+    saved = tmp_path / "tour.pickle"
+    saved.write_bytes(pickle.dumps((tour, (frame.origin_lat_deg, frame.origin_lon_deg))))
     # both at once: the one pinned to one core, the other on all of them
-    running = [subprocess.Popen([sys.executable, "-c", _ONE_DESIGN.format(tests=tests, one_core=one)],
+    running = [subprocess.Popen([sys.executable, "-c", _ONE_DESIGN.format(
+                                     tests=tests, one_core=one, tour=str(saved))],
                                 stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True)
                for one in (True, False)]
     results = []
