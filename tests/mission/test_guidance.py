@@ -287,7 +287,7 @@ def test_the_turn_margin_keeps_a_design_that_holds_and_otherwise_ranks_by_the_fl
     # 5 m without second passes)
     strict = MissionSettings(altitude_m=120.0, airspeed_m_s=22.0, design="guidance",
                              max_miss_m=4.0, tuning=DesignTuning(
-                                 revisits=False, slow_rounds=0, guidance_margins=(1.3, 1.6)))
+                                 revisits=False, slow_rounds=0, guidance_margins=(1.3,)))
     mission = build_mission(tour, frame, targets, strict)
     assert targets_beyond(mission) > 0
     chosen = with_turn_margin(mission, replan, targets, strict)
@@ -338,6 +338,11 @@ def _clustered(count: int, seed: int):
     return local_targets(points).to_geodetic(LocalFrame(*CENTRE))
 
 
+#: The clustered sites' settings: the stock aircraft at 22 m/s, forecast wind only.
+_CLUSTERED_SETTINGS = MissionSettings(design="guidance", airspeed_m_s=22.0, altitude_m=120.0,
+                                      home_deg=CENTRE, wind_spread_m_s=0.0)
+
+
 @pytest.fixture(scope="module")
 def clustered_stuck():
     """A clustered site (80 targets, seed 2, rho 80 m; forecast wind only), its settings, and
@@ -346,8 +351,7 @@ def clustered_stuck():
     from dtsp_mission.api import plan_tour
     targets = _clustered(80, 2)
     tour, frame = plan_tour(targets, 80.0)
-    settings = MissionSettings(design="guidance", airspeed_m_s=22.0, altitude_m=120.0,
-                               home_deg=CENTRE, wind_spread_m_s=0.0)
+    settings = _CLUSTERED_SETTINGS
     stuck = build_mission(tour, frame, targets, replace(
         settings, tuning=DesignTuning(local_reset=False, revisits=False, slow_rounds=0)))
     return tour, frame, targets, settings, stuck
@@ -405,7 +409,7 @@ def test_a_mission_designed_for_the_wind_holds_in_it_what_a_calm_design_misses()
 
 
 @pytest.mark.heavy(seconds=40)
-def test_a_target_left_beyond_is_passed_again_later_and_held(clustered_stuck):
+def test_a_target_left_beyond_is_passed_again_later_and_held():
     """On another clustered site (seed 5), without the second search the design leaves targets
     beyond its limit (5 today); with revisits each such target is passed a second time later in
     the mission -- one waypoint over it, at its altitude and acceptance radius -- which brings
@@ -415,7 +419,7 @@ def test_a_target_left_beyond_is_passed_again_later_and_held(clustered_stuck):
     from the start, passes the targets as the design reports."""
     from dtsp_mission.api import plan_tour
     from dtsp_mission.mission.widening import targets_beyond as beyond
-    settings = clustered_stuck[3]
+    settings = _CLUSTERED_SETTINGS
     targets = _clustered(80, 5)
     tour, frame = plan_tour(targets, 80.0)
     # judged by the forecast and the design winds only (as measured; with the turn spread the
