@@ -79,7 +79,12 @@ CODES = {"3177ef3": "3177ef3, before the real flights (the baseline)",
          "db7151b6": "199f907: and no cross-track on the leg after a take-off (ArduPlane's "
                      "verify_takeoff)",
          "ba1d51b7": "7adc74c without the flip guard (DesignTuning.flip_* 0; a trial: not the "
-                     "default)"}
+                     "default)",
+         "5466a837": "0128abe-6566c7d: the same designs as db7151b6 (a refactor; ArduPlane's SITL "
+                     "flown at 40 x)",
+         "f23f08ea": "the same designs, the local repair's trials flying their winds one after "
+                     "the other, heaviest first, until the bound is met (the README's plan "
+                     "29-31 s instead of 34-35)"}
 #: Digests of trials of design options that are not the default: listed beside the default's
 #: latest flight of the case, never as the case's result.
 TRIALS = {"fb944b1d": "aims within 15 m",

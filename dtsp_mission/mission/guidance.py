@@ -612,21 +612,35 @@ def _refine(aim: np.ndarray, target_of: list[int], items: list[LocalItem], seqs:
             def local_cost(points: np.ndarray, bound: float = math.inf,
                            parallel: bool = True) -> float:
                 """The window's cost with these aims; a trial that cannot beat ``bound`` may
-                be cut short: one wind's misses (the one that weighed most last time) already
-                bound the cost from below (the judged miss is their maximum, less the margin
-                for the winds after the forecast), so the cost returned is then only a value
-                at least ``bound``.  Exact otherwise: the same decisions as flying every wind.
+                be cut short: the misses of the winds flown so far bound the cost from below
+                (the judged miss is their maximum, less the margin for the winds after the
+                forecast), so the cost returned is then only a value at least ``bound``.  The
+                winds are flown heaviest first (their weights in the last full trial), one at
+                a time in a trial that already runs on one core, and stop as soon as the bound
+                is met.  Exact otherwise: the same decisions as flying every wind.
                 ``parallel`` flies the other winds on every core (not from a trial that
-                already runs on one)."""
+                already runs on one) after the heaviest."""
                 changed = with_aims(points)
                 lead = leading[0]
                 misses: list[np.ndarray | None] = [None] * len(checkpoints)
                 if bound < math.inf and len(checkpoints) > 1:
                     misses[lead] = flown(changed, checkpoints[lead])
-                    alone = misses[lead] - _margin(spread_margin_m, lead)
-                    low = float(_Trial.cost_of(alone, max_miss_m, tuning.beyond_cost).sum())
+                    judged = misses[lead] - _margin(spread_margin_m, lead)
+                    low = float(_Trial.cost_of(judged, max_miss_m, tuning.beyond_cost).sum())
                     if low >= bound:
                         return low
+                    if not parallel:
+                        # one wind after the other, each raising the judged misses (their
+                        # maximum) and so the bound from below: stopped as soon as it is met
+                        for i in heaviest[0]:
+                            if misses[i] is not None:
+                                continue
+                            misses[i] = flown(changed, checkpoints[i])
+                            judged = np.maximum(judged, misses[i] - _margin(spread_margin_m, i))
+                            low = float(_Trial.cost_of(judged, max_miss_m,
+                                                       tuning.beyond_cost).sum())
+                            if low >= bound:
+                                return low
                 rest = [i for i in range(len(checkpoints)) if misses[i] is None]
                 fly_rest = (lambda i: flown(changed, checkpoints[i]))
                 for i, miss in zip(rest, _each(fly_rest, rest) if parallel
@@ -636,6 +650,7 @@ def _refine(aim: np.ndarray, target_of: list[int], items: list[LocalItem], seqs:
                 weights = [_Trial.cost_of(m - _margin(spread_margin_m, i), max_miss_m,
                                           tuning.beyond_cost).sum() for i, m in enumerate(misses)]
                 leading[0] = int(np.argmax(weights))
+                heaviest[0] = [int(i) for i in np.argsort(weights, kind="stable")[::-1]]
                 return float(_Trial.cost_of(worst, max_miss_m, tuning.beyond_cost).sum())
 
             def descend(candidate: np.ndarray, current: float, step_m: float
@@ -666,6 +681,7 @@ def _refine(aim: np.ndarray, target_of: list[int], items: list[LocalItem], seqs:
 
             first_step_m = max(min(miss[t] - max_miss_m, 10.0), 1.0)
             leading = [0]           # the wind whose misses weighed most in the last full trial
+            heaviest = [list(range(len(checkpoints)))]   # the winds, heaviest first
             initial = local_cost(aim)
             candidate, current = descend(aim.copy(), initial, first_step_m)
             if current > 0.0 and tuning.local_reset:
