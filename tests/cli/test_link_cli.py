@@ -366,8 +366,15 @@ def test_ctrl_c_during_an_upload_says_what_the_vehicle_may_hold(tmp_path, start_
         deadline = time.monotonic() + 60
         while vehicle.server.counts["requests_sent"] < 5 and time.monotonic() < deadline:
             time.sleep(0.05)
+        requested = vehicle.server.counts["requests_sent"]
         process.send_signal(signal.SIGINT)
-        out, err = process.communicate(timeout=60)
+        try:
+            out, err = process.communicate(timeout=60)
+        except subprocess.TimeoutExpired:
+            process.kill()
+            out, err = process.communicate()
+            pytest.fail(f"no exit within 60 s of SIGINT (sent after {requested} item requests, "
+                        f"{vehicle.server.counts['requests_sent']} by the kill): {out!r} {err!r}")
     assert process.returncode == 130, (out, err)
     assert "Traceback" not in err and "Aborted!" not in err
     assert re.search(r"interrupted after \d+ of \d+ items were sent: ArduPilot writes items", err), err
