@@ -349,6 +349,12 @@ class VehicleMissionAt:
         self.home, self.autopilot = home, Autopilot.ARDUPILOTMEGA
 
 
+#: ``python -c`` this, then the command's arguments: ``dtsp-mission`` with Ctrl-C raising
+#: KeyboardInterrupt whatever SIGINT's disposition was when the process started.
+_WITH_CTRL_C = ("import runpy, signal, sys; signal.signal(signal.SIGINT, signal.default_int_handler); "
+                "sys.argv[0] = 'dtsp-mission'; runpy.run_module('dtsp_mission.cli', run_name='__main__')")
+
+
 def test_ctrl_c_during_an_upload_says_what_the_vehicle_may_hold(tmp_path, start_vehicle):
     """SIGINT while the items go out (a slow link: every datagram delayed): exit 130 and what
     an ArduPilot holds then, not click's bare "Aborted!"."""
@@ -360,7 +366,10 @@ def test_ctrl_c_during_an_upload_says_what_the_vehicle_may_hold(tmp_path, start_
     exporter_for(path).write(big, path)
     vehicle = start_vehicle(big)
     with FaultProxy(("127.0.0.1", vehicle.port), Faults(delay_s=0.08, seed=1)) as proxy:
-        process = subprocess.Popen([sys.executable, "-m", "dtsp_mission.cli", "upload", str(path),
+        # The command as a terminal runs it, Ctrl-C delivered: a shell that starts the suite in
+        # the background ignores SIGINT for it, and every child inherits that (Python then
+        # keeps ignoring it), so the child takes the interpreter's own handler back first.
+        process = subprocess.Popen([sys.executable, "-c", _WITH_CTRL_C, "upload", str(path),
                                     "--connect", f"udpout:127.0.0.1:{proxy.port}"],
                                    stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True)
         deadline = time.monotonic() + 60
