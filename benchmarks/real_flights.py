@@ -84,7 +84,9 @@ CODES = {"3177ef3": "3177ef3, before the real flights (the baseline)",
                      "flown at 40 x)",
          "f23f08ea": "the same designs, the local repair's trials flying their winds one after "
                      "the other, heaviest first, until the bound is met (the README's plan "
-                     "29-31 s instead of 34-35)"}
+                     "29-31 s instead of 34-35)",
+         "3781ba7b": "the same designs as f23f08ea (a review: the heaviest wind read from the "
+                     "winds' order, not kept apart)"}
 #: Digests of trials of design options that are not the default: listed beside the default's
 #: latest flight of the case, never as the case's result.
 TRIALS = {"fb944b1d": "aims within 15 m",

@@ -621,7 +621,7 @@ def _refine(aim: np.ndarray, target_of: list[int], items: list[LocalItem], seqs:
                 ``parallel`` flies the other winds on every core (not from a trial that
                 already runs on one) after the heaviest."""
                 changed = with_aims(points)
-                lead = leading[0]
+                lead = heaviest[0][0]
                 misses: list[np.ndarray | None] = [None] * len(checkpoints)
                 if bound < math.inf and len(checkpoints) > 1:
                     misses[lead] = flown(changed, checkpoints[lead])
@@ -649,8 +649,7 @@ def _refine(aim: np.ndarray, target_of: list[int], items: list[LocalItem], seqs:
                 worst = _judged(misses, spread_margin_m)
                 weights = [_Trial.cost_of(m - _margin(spread_margin_m, i), max_miss_m,
                                           tuning.beyond_cost).sum() for i, m in enumerate(misses)]
-                leading[0] = int(np.argmax(weights))
-                heaviest[0] = [int(i) for i in np.argsort(weights, kind="stable")[::-1]]
+                heaviest[0] = sorted(range(len(weights)), key=lambda i: -weights[i])
                 return float(_Trial.cost_of(worst, max_miss_m, tuning.beyond_cost).sum())
 
             def descend(candidate: np.ndarray, current: float, step_m: float
@@ -680,8 +679,8 @@ def _refine(aim: np.ndarray, target_of: list[int], items: list[LocalItem], seqs:
                 return candidate, current
 
             first_step_m = max(min(miss[t] - max_miss_m, 10.0), 1.0)
-            leading = [0]           # the wind whose misses weighed most in the last full trial
-            heaviest = [list(range(len(checkpoints)))]   # the winds, heaviest first
+            # the winds by the weight of their misses in the last full trial, heaviest first
+            heaviest = [list(range(len(checkpoints)))]
             initial = local_cost(aim)
             candidate, current = descend(aim.copy(), initial, first_step_m)
             if current > 0.0 and tuning.local_reset:
