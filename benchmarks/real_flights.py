@@ -86,7 +86,10 @@ CODES = {"3177ef3": "3177ef3, before the real flights (the baseline)",
                      "the other, heaviest first, until the bound is met (the README's plan "
                      "29-31 s instead of 34-35)",
          "3781ba7b": "the same designs as f23f08ea (a review: the heaviest wind read from the "
-                     "winds' order, not kept apart)"}
+                     "winds' order, not kept apart)",
+         "cd1e4a46": "in a forecast wind, the targets passed twice entered along straights "
+                     "planned into the tour (1.2 L1 at the fastest ground speed) where that "
+                     "design flies shorter in the model; calm designs as before"}
 #: Digests of trials of design options that are not the default: listed beside the default's
 #: latest flight of the case, never as the case's result.
 TRIALS = {"fb944b1d": "aims within 15 m",

@@ -162,14 +162,22 @@ def build_mission(tour: Tour, frame: LocalFrame, targets: GeoTargets,
     ``max_items`` (with ArduPilot's home slot) or :class:`InputError` says how many are needed.
     ``progress(flights, rounds)`` follows the guidance design's predicted flights.
     """
-    prepared = _prepare(tour, frame, targets, settings)
+    prepared, given = _prepare(tour, frame, targets, settings), settings
     settings, path, at_targets, notes = (prepared.settings, prepared.path, prepared.at_targets,
                                          prepared.notes)
     (home_lat, home_lon), home_m = prepared.home_deg, prepared.home_m
-    design = None
+    design, asked = None, tour
     if settings.design == "guidance":
-        design = design_for_guidance(path, tour, frame, targets, settings, at_targets.count,
-                                      progress)
+        design, path, tour = design_for_guidance(
+            path, tour, frame, targets, settings, at_targets.count, progress,
+            path_of=lambda led: _prepare(led, frame, targets, given).path)
+        if tour is not asked:
+            at_targets = _prepare(tour, frame, targets, given).at_targets
+            led = np.flatnonzero(tour.lead_in_m > 0)
+            notes.append(f"straight lead-ins planned into the tour before {len(led)} targets "
+                         f"the guidance held from it only with second passes: the tour "
+                         f"{asked.length_m / 1e3:,.2f} -> {tour.length_m / 1e3:,.2f} km, "
+                         f"flown in less time (in the model, the forecast wind)")
         chosen, tolerance = design.s_m, float("nan")
         judged = design.judged_miss_m
         held = judged <= settings.design_limit_m
@@ -191,6 +199,9 @@ def build_mission(tour: Tour, frame: LocalFrame, targets: GeoTargets,
     items = at_targets.inserted(mission_items(path, chosen, frame, targets, settings, home_lat, home_lon,
                                        design))
     summary = _summary(tour, path, items, settings, home_m, design)
+    if design is not None and tour is not asked:
+        # the tour as planned (at the radius asked), and the one the mission flies
+        summary.update(tour_length_m=asked.length_m, lead_in_tour_length_m=tour.length_m)
     if at_targets.count:
         counts = Counter(item.role for item in items)
         summary["actions"] = {role: counts[role] for role in ("photo", "roi", "gimbal", "loiter")

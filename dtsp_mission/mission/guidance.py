@@ -46,7 +46,9 @@ checked against recorded ArduPlane flights) and repairing what it misses:
    far before the next waypoint of the leg the detour leaves (so that waypoint is approached as
    before); up to ``detour_rounds`` rounds, kept likewise.  A target's miss is the closest of
    its passes.  Only if targets stay beyond does the wider-turn stage plan the tour again
-   (:mod:`.widening`).
+   (:mod:`.widening`).  In a forecast wind the targets passed twice are instead entered along
+   straights planned into the tour and that tour designed again, kept if it flies shorter
+   (``stuck_lead_in_l1``, :func:`dtsp_mission.mission.waypoints.design_for_guidance`).
 
 The rounds 2-5 (at the coarser ``prediction_step_s``) hold the targets within ``max_miss_m -
 PREDICTION_MARGIN_M``; the verifying flight and the local repair within ``max_miss_m -
@@ -224,6 +226,17 @@ class DesignTuning:
     #: measured, docs/design-time.md: 0 instead of 3 plans the bundled site in 33.5 s instead
     #: of 63 s on one core, every benchmark site held in the model, flights within 2 %).
     slow_first_refine_passes: int = 0
+    #: In a forecast wind, the targets the design passes twice (or leaves beyond) are entered
+    #: instead along a straight this many L1 distances long (the L1 distance at the fastest
+    #: ground speed, the airspeed plus the wind) planned into the tour
+    #: (:mod:`dtsp_mission.planning.lead_ins`), and that tour designed the same way; it is
+    #: kept if it holds as many targets in a shorter predicted flight.  A target entered
+    #: mid-turn holds only for the forecast wind; on a straight the guidance has settled
+    #: whatever the wind.  Measured in the model (docs/design-time.md): uniform 100 in 8 m/s
+    #: 1.56 -> 1.40 x the tour for the wind, the bundled site in 8 m/s 1.97 -> 1.69; in calm
+    #: air a second pass costs less than the straight (bundled: 1,402 -> 1,422-1,581 s), so
+    #: none there.  None: never.
+    stuck_lead_in_l1: float | None = 1.2
     revisit_turn_m: float = 80.0
     revisit_apart: int = 4
     revisit_rounds: int = 3

@@ -16,8 +16,9 @@ from ..frame import LocalFrame
 from ..targets import GeoTargets
 from ..tour import Tour
 from ..autopilot.commands import Command
+from ..planning.lead_ins import with_lead_ins
 from .discretise import waypoint_s
-from .guidance import DesignTuning, GuidanceDesign, design_waypoints
+from .guidance import DesignTuning, GuidanceDesign, design_waypoints, revisited
 from .model import FlightPath
 from .settings import PREFERRED_TOLERANCE_FRACTION, MissionSettings
 
@@ -68,21 +69,27 @@ def fit_waypoints(path: FlightPath, rho_m: float, settings: MissionSettings,
 
 def design_for_guidance(path: FlightPath, tour: Tour, frame: LocalFrame, targets: GeoTargets,
                          settings: MissionSettings, actions: int = 0,
-                         progress: Callable[[int, int], None] | None = None) -> GuidanceDesign:
+                         progress: Callable[[int, int], None] | None = None,
+                         path_of: Callable[[Tour], FlightPath] | None = None
+                         ) -> tuple[GuidanceDesign, FlightPath, Tour]:
     """Waypoints for the autopilot's guidance (:mod:`.guidance`, flying
     :meth:`MissionSettings.design_airframe`) within the item budget; the lead-out of a landing
-    stays a geometric polyline."""
+    stays a geometric polyline.  Returned with the path and tour they fly: ``tour`` itself, or
+    with ``DesignTuning.stuck_lead_in_l1`` (and ``path_of``, the flight path of a tour), in a
+    forecast wind, the tour with straight lead-ins before the targets the design passes twice
+    where that design holds as many targets in a shorter predicted flight."""
     airframe = settings.design_airframe()
-    tail = guidance_tail(path, tour, settings, actions)
-    budget = settings.max_items - fixed_items(settings, actions) - len(tail)
     head = ([(Command.DO_CHANGE_SPEED, (0.0, float(settings.airspeed_m_s), -1.0, 0.0))]
             if settings.airspeed_m_s is not None else [])
     altitudes = (np.full(len(tour.targets_m), settings.altitude_m) if targets.altitudes_m is None
                  else np.asarray(targets.altitudes_m, dtype=float))
     altitudes = np.where(np.isnan(altitudes), settings.altitude_m, altitudes)   # not given
-    lead_s_m = lead_in_starts_m(path, tour)
 
     def designed(tuning: DesignTuning, slow_targets: tuple[int, ...] = ()) -> GuidanceDesign:
+        """The design of ``path`` (of ``tour``) as they are when called."""
+        budget = (settings.max_items - fixed_items(settings, actions)
+                  - len(guidance_tail(path, tour, settings, actions)))
+        lead_s_m = lead_in_starts_m(path, tour)
         return design_waypoints(path, tour.targets_m, altitudes, airframe, settings.design_limit_m,
                                 budget, head, settings.target_acceptance_m, progress=progress,
                                 as_stored=lambda points: stored_position_m(frame, points),
@@ -96,19 +103,47 @@ def design_for_guidance(path: FlightPath, tour: Tour, frame: LocalFrame, targets
         # start of a second design: its repair aims every waypoint for the speed it is flown
         # at.  (Starting it from the first design's waypoints and aims was measured: bundled
         # site 28.6 km instead of 25.1 km, no faster.)
-        first = designed(replace(tuning, revisits=False, slow_rounds=0,
-                                 refine_passes=min(tuning.refine_passes, tuning.slow_first_refine_passes)))
-        stuck = tuple(int(t) for t in np.flatnonzero(
-            first.judged_miss_m > settings.design_limit_m - tuning.slow_margin_m))
-        design = designed(tuning, stuck) if stuck else first
+        def slowed() -> GuidanceDesign:
+            """The design of the path as it is, slowing for what a first design cannot hold."""
+            first = designed(replace(tuning, revisits=False, slow_rounds=0,
+                                     refine_passes=min(tuning.refine_passes,
+                                                       tuning.slow_first_refine_passes)))
+            stuck = tuple(int(t) for t in np.flatnonzero(
+                first.judged_miss_m > settings.design_limit_m - tuning.slow_margin_m))
+            return designed(tuning, stuck) if stuck else first
+        design = slowed()
+        passed_again = {revisited(int(marker)) for marker in design.target_of} - {-1}
+        held_again = sorted(passed_again | set(np.flatnonzero(
+            design.judged_miss_m > settings.design_limit_m).tolist()))
+        if (held_again and tuning.stuck_lead_in_l1 and path_of is not None
+                and settings.wind.speed_m_s > 0):
+            # In a forecast wind the targets passed twice (or not held) are entered along a
+            # straight planned into the tour instead, and that tour designed: kept if it holds
+            # as many targets in a shorter predicted flight (docs/design-time.md).
+            fastest = airframe.airspeed_m_s + settings.wind.speed_m_s
+            lead_m = tuning.stuck_lead_in_l1 * airframe.l1_distance_m(fastest)
+            led_tour = with_lead_ins(tour, {int(t): lead_m for t in held_again})
+            plain = (path, tour)
+            path, tour = path_of(led_tour), led_tour
+            led = slowed()
+            if (_beyond(led, settings.design_limit_m), led.predicted_time_s) < (
+                    _beyond(design, settings.design_limit_m), design.predicted_time_s):
+                design = led
+            else:
+                path, tour = plain
     else:
         design = designed(tuning)
+    tail = guidance_tail(path, tour, settings, actions)
     return replace(design, s_m=np.concatenate([[0.0], design.s_m, tail]),
                    aim_m=np.vstack([path.chain.pose_at(np.array([0.0]))[:, :2], design.aim_m,
                                     path.chain.pose_at(tail)[:, :2].reshape(-1, 2)]),
                    target_of=np.concatenate([[-1], design.target_of, np.full(len(tail), -1)]),
                    speed_before_m_s=(None if design.speed_before_m_s is None else np.concatenate(
-                       [[np.nan], design.speed_before_m_s, np.full(len(tail), np.nan)])))
+                       [[np.nan], design.speed_before_m_s, np.full(len(tail), np.nan)]))), path, tour
+
+
+def _beyond(design: GuidanceDesign, limit_m: float) -> int:
+    return int((design.judged_miss_m > limit_m).sum())
 
 
 def lead_in_starts_m(path: FlightPath, tour: Tour) -> np.ndarray:

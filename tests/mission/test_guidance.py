@@ -566,6 +566,39 @@ def test_a_tour_with_lead_ins_is_designed_with_a_waypoint_where_each_straight_be
         assert np.hypot(*(placed - point).T).min() < 0.05
 
 
+@pytest.mark.heavy(seconds=15)
+def test_in_wind_targets_passed_twice_are_entered_along_a_straight_planned_into_the_tour():
+    """In 8 m/s (20 targets over 2 km) the design holds two targets only by passing them
+    again; with straight lead-ins planned into the tour before those two the design holds
+    every target on the first pass, in a shorter predicted flight (measured: 634 -> 474 s),
+    and that mission is the one returned: its tour has the lead-ins, passes the checker, and
+    the summary gives both tours."""
+    from dtsp_mission.autopilot.navigation import Wind
+    from dtsp_mission.tour.check import check_tour
+    tour, frame, targets = sparse_site(20, seed=1, side=2000.0)
+    settings = MissionSettings(design="guidance", airspeed_m_s=22.0, altitude_m=120.0,
+                               wind=Wind(8.0, 40.0))
+    plain = build_mission(tour, frame, targets, replace(
+        settings, tuning=DesignTuning(stuck_lead_in_l1=None)))
+    passed_again = {item.target for item in plain.items if item.role == "revisit"}
+    assert plain.tour is tour and len(passed_again) == 2
+    led = build_mission(tour, frame, targets, settings)
+    assert led.tour is not tour and check_tour(led.tour).ok
+    assert set(np.flatnonzero(led.tour.lead_in_m > 0).tolist()) == passed_again
+    airframe = settings.checked(80.0).design_airframe()
+    lead_m = DesignTuning().stuck_lead_in_l1 * airframe.l1_distance_m(22.0 + 8.0)
+    assert np.all(led.tour.lead_in_m[list(passed_again)] >= lead_m - 1e-6)
+    assert led.guidance.targets_beyond() == 0 and led.guidance.revisit_waypoints == 0
+    assert led.guidance.predicted_flight_s < 0.9 * plain.guidance.predicted_flight_s
+    assert led.summary["tour_length_m"] == tour.length_m
+    assert led.summary["lead_in_tour_length_m"] == led.tour.length_m > tour.length_m
+    assert any("straight lead-ins planned into the tour before 2 targets" in note
+               for note in led.notes)
+    # calm air: a second pass costs less there than the straight (measured), no lead-ins
+    calm = build_mission(tour, frame, targets, replace(settings, wind=Wind(0.0, 0.0)))
+    assert calm.tour is tour
+
+
 _ONE_DESIGN = """
 import hashlib, os, pickle, sys
 sys.path.insert(0, {tests!r})
