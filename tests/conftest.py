@@ -29,6 +29,32 @@ def assert_valid_tour(tour: Tour) -> None:
     assert report.ok, report.summary() + "\n" + "\n".join(report.problems)
 
 
+_WARM_UP_TARGETS = "lat,lon\n" + "".join(
+    f"{47.3977 + 0.004 * (k % 4):.6f},{8.5456 + 0.006 * (k // 4):.6f}\n" for k in range(12))
+
+
+def pytest_configure(config) -> None:
+    """On a machine where the compiled kernels are not cached yet (a fresh clone), compile
+    them once, in one process, before the workers start: otherwise each worker and each
+    command a test runs compiles them at the same time (about 40 s of CPU each)."""
+    import os
+    import subprocess
+    import sys
+    import tempfile
+    from dtsp_mission.compiled import kernels_cached
+    if hasattr(config, "workerinput") or kernels_cached():
+        return
+    with tempfile.TemporaryDirectory() as folder:
+        targets = os.path.join(folder, "targets.csv")
+        with open(targets, "w") as file:
+            file.write(_WARM_UP_TARGETS)
+        # a guidance design in wind, written: the planner's, the Dubins, the wind tour's and
+        # the flight model's kernels
+        subprocess.run([sys.executable, "-m", "dtsp_mission.cli", "plan", targets, "--radius",
+                        "80", "--airspeed", "22", "--alt", "120", "--wind", "5@90", "-q", "-o",
+                        os.path.join(folder, "warm.plan")], capture_output=True, timeout=600)
+
+
 def pytest_collection_modifyitems(items: list) -> None:
     """The tests marked ``heavy`` first, longest first (``seconds``: as measured on 2 cores),
     then the rest: started last, a test of minutes would keep one worker busy long after the
