@@ -62,7 +62,8 @@ S_TKO_EXCESS, S_TKO_END = 29, 30                    # airspeed over the target l
 S_SPEED_HELD = 31                                   # the airspeed demand on its way to the target
 S_DIRECT = 32                                       # 1: ArduPlane flies to the waypoint without
                                                     # cross-tracking (the leg after a take-off)
-STATE_SIZE = 33
+S_SPEED_FOLLOW, S_SPEED_FOLLOW_RATE = 33, 34        # the airspeed following the demand up, its rate
+STATE_SIZE = 35
 
 # -- the airframe vector -----------------------------------------------------------------------
 (A_AIRSPEED, A_L1_PERIOD, A_WP_RADIUS, A_ROLL_W, A_ROLL_Z, A_L1_DAMPING,
@@ -89,7 +90,12 @@ A_BANK_SPEED = 29
 A_SPEED_UP, A_SPEED_DOWN = 30, 31
 # The most roll rate the roll controller asks for (rad/s; ArduPlane's RLL2SRV_RMAX; 0: none).
 A_ROLL_RATE_MAX = 32
-AIRFRAME_SIZE = 33
+# How the airspeed follows its demand when it rises (a second-order response: natural
+# frequency rad/s and damping; 0: it is the demand): ArduPlane SITL's stock plane gains speed
+# at once under the throttle and overshoots as TECS trades height back.  A fall follows the
+# demand as it is.
+A_SPEED_UP_W, A_SPEED_UP_Z = 33, 34
+AIRFRAME_SIZE = 35
 
 LOITER_EXIT_HEADING_RAD = math.radians(10.0)
 TWO_PI = 2.0 * math.pi
@@ -409,6 +415,7 @@ def _skip_instant_items(st, af, command, params, reached, counts):
             if af[A_SPEED_TC] <= 0.0 and af[A_SPEED_UP] <= 0.0 and af[A_SPEED_DOWN] <= 0.0:
                 st[S_AIRSPEED] = st[S_SPEED_TARGET]
                 st[S_SPEED_HELD] = st[S_SPEED_TARGET]
+                st[S_SPEED_FOLLOW] = st[S_SPEED_TARGET]
         _record_reached(reached, counts, i, st[S_TIME])
         i += 1
     st[S_INDEX] = i
@@ -556,6 +563,7 @@ def _step_takeoff(st, af, command, position, params, reached, counts, dt):
                 st[S_TKO_END] = st[S_TIME]
         st[S_SPEED_TARGET] = af[A_AIRSPEED]
         st[S_SPEED_HELD] = af[A_AIRSPEED]
+        st[S_SPEED_FOLLOW], st[S_SPEED_FOLLOW_RATE] = af[A_AIRSPEED], 0.0
         _complete(st, af, command, position, params, reached, counts, 0.0, 0.0, 0.0, False)
 
 
@@ -585,13 +593,23 @@ def step(st, af, command, position, params, following, reached, counts, dt):
     if af[A_SPEED_TC] > 0.0:
         st[S_AIRSPEED] += (st[S_SPEED_TARGET] - st[S_AIRSPEED]) * min(dt / af[A_SPEED_TC], 1.0)
     elif (st[S_TKO_EXCESS] > 0.0 or af[A_BANK_SPEED] > 0.0
-          or st[S_SPEED_HELD] != st[S_SPEED_TARGET]):
+          or st[S_SPEED_HELD] != st[S_SPEED_TARGET]
+          or st[S_SPEED_FOLLOW_RATE] != 0.0 or st[S_SPEED_FOLLOW] != st[S_SPEED_HELD]):
         held, target = st[S_SPEED_HELD], st[S_SPEED_TARGET]
         if target > held:
             held = min(target, held + af[A_SPEED_UP] * dt) if af[A_SPEED_UP] > 0.0 else target
         elif target < held:
             held = max(target, held - af[A_SPEED_DOWN] * dt) if af[A_SPEED_DOWN] > 0.0 else target
         st[S_SPEED_HELD] = held
+        if af[A_SPEED_UP_W] > 0.0 and target >= held:
+            # rising (or settled after rising): the airspeed's second-order response to the demand
+            w = af[A_SPEED_UP_W]
+            rate = st[S_SPEED_FOLLOW_RATE]
+            rate += (w * w * (held - st[S_SPEED_FOLLOW]) - 2.0 * af[A_SPEED_UP_Z] * w * rate) * dt
+            st[S_SPEED_FOLLOW_RATE] = rate
+            st[S_SPEED_FOLLOW] += rate * dt
+        else:
+            st[S_SPEED_FOLLOW], st[S_SPEED_FOLLOW_RATE] = held, 0.0
         excess = 0.0
         if st[S_TKO_EXCESS] > 0.0:        # the climb-out's airspeed bled off to the target
             bled = af[A_TKO_END_DECAY] * max(st[S_TIME] - st[S_TKO_END] - af[A_TKO_END_HOLD], 0.0)
@@ -601,7 +619,7 @@ def step(st, af, command, position, params, following, reached, counts, dt):
                 excess = 0.0
         # faster in a bank (the load factor's excess), slower again as it levels
         excess += af[A_BANK_SPEED] * (1.0 / math.cos(st[S_BANK]) - 1.0)
-        st[S_AIRSPEED] = held + excess
+        st[S_AIRSPEED] = st[S_SPEED_FOLLOW] + excess
     if c == NAV_LOITER_TURNS or c == NAV_LOITER_TIME:
         _step_loiter(st, af, command, position, params, following, reached, counts, dt)
         return
@@ -815,6 +833,7 @@ def new_state(heading_rad: float, airspeed_m_s: float, first_index: int) -> np.n
     st[S_AIRSPEED] = airspeed_m_s
     st[S_SPEED_TARGET] = airspeed_m_s
     st[S_SPEED_HELD] = airspeed_m_s
+    st[S_SPEED_FOLLOW] = airspeed_m_s
     st[S_INDEX] = first_index
     st[S_MEASURE_START] = math.nan
     st[S_LAST_WAYPOINT_UPDATE] = -math.inf
