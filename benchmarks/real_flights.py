@@ -89,7 +89,11 @@ CODES = {"3177ef3": "3177ef3, before the real flights (the baseline)",
                      "winds' order, not kept apart)",
          "cd1e4a46": "in a forecast wind, the targets passed twice entered along straights "
                      "planned into the tour (1.2 L1 at the fastest ground speed) where that "
-                     "design flies shorter in the model; calm designs as before"}
+                     "design flies shorter in the model; calm designs as before",
+         "3b75b7f3": "ade9835: the model's airspeed after a DO_CHANGE_SPEED as the real SITL "
+                     "flies it (the demand at 1.5 / 0.48 m/s^2, a rise followed as a "
+                     "second-order response that overshoots): every design with slow zones "
+                     "made again"}
 #: Digests of trials of design options that are not the default: listed beside the default's
 #: latest flight of the case, never as the case's result.
 TRIALS = {"fb944b1d": "aims within 15 m",
