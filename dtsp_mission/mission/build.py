@@ -168,11 +168,15 @@ def build_mission(tour: Tour, frame: LocalFrame, targets: GeoTargets,
     (home_lat, home_lon), home_m = prepared.home_deg, prepared.home_m
     design, asked = None, tour
     if settings.design == "guidance":
+        tried: list[tuple[Tour, _Prepared]] = []     # the tours with lead-ins, prepared once
+
+        def path_of(led: Tour) -> FlightPath:
+            tried.append((led, _prepare(led, frame, targets, given)))
+            return tried[-1][1].path
         design, path, tour = design_for_guidance(
-            path, tour, frame, targets, settings, at_targets.count, progress,
-            path_of=lambda led: _prepare(led, frame, targets, given).path)
+            path, tour, frame, targets, settings, at_targets.count, progress, path_of=path_of)
         if tour is not asked:
-            at_targets = _prepare(tour, frame, targets, given).at_targets
+            at_targets = next(ready for led, ready in tried if led is tour).at_targets
             led = np.flatnonzero(tour.lead_in_m > 0)
             notes.append(f"straight lead-ins planned into the tour before {len(led)} targets "
                          f"the guidance held from it only with second passes: the tour "
